@@ -1,0 +1,41 @@
+#include "core/strings.h"
+
+#include <algorithm>
+#include <cctype>
+
+namespace refray {
+
+size_t editDistance(std::string_view a, std::string_view b) {
+    std::vector<size_t> previous(b.size() + 1), current(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) previous[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+        current[0] = i;
+        for (size_t j = 1; j <= b.size(); ++j) {
+            const bool same = std::tolower((unsigned char)a[i - 1]) == std::tolower((unsigned char)b[j - 1]);
+            current[j] = std::min({previous[j] + 1, current[j - 1] + 1, previous[j - 1] + (same ? 0 : 1)});
+        }
+        std::swap(previous, current);
+    }
+    return previous[b.size()];
+}
+
+std::optional<std::string> closestMatch(std::string_view name, const std::vector<std::string>& candidates) {
+    const size_t limit = std::max<size_t>(2, name.size() / 3);
+    std::optional<std::string> best;
+    size_t bestDistance = limit + 1;
+    for (const auto& c : candidates) {
+        const size_t d = editDistance(name, c);
+        if (d < bestDistance) {
+            bestDistance = d;
+            best = c;
+        }
+    }
+    return best;
+}
+
+std::string didYouMean(std::string_view name, const std::vector<std::string>& candidates) {
+    auto match = closestMatch(name, candidates);
+    return match ? " (did you mean '" + *match + "'?)" : std::string();
+}
+
+}  // namespace refray

@@ -1,0 +1,1049 @@
+// DispatchRays and TraceRay: the DXR control flow of dxr-semantics.md sections 4-11.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <random>
+
+#include <tbb/blocked_range2d.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "emulator/device.h"
+#include "emulator/embree_bridge.h"
+#include "emulator/limits.h"
+#include "emulator/shader_api.h"
+
+namespace refray::dxr {
+
+void DispatchStats::merge(const DispatchStats& o) {
+    raysTraced += o.raysTraced;
+    candidates += o.candidates;
+    if (raysPerDepth.size() < o.raysPerDepth.size()) raysPerDepth.resize(o.raysPerDepth.size());
+    for (size_t i = 0; i < o.raysPerDepth.size(); ++i) raysPerDepth[i] += o.raysPerDepth[i];
+    for (size_t i = 0; i < invocations.size(); ++i) invocations[i] += o.invocations[i];
+}
+
+namespace detail {
+
+struct DispatchState {
+    Device* device = nullptr;
+    const GpuMemory* memory = nullptr;
+    const StateObject* pipeline = nullptr;
+    const DispatchRaysDesc* desc = nullptr;
+    const GlobalRootArguments* global = nullptr;
+    DispatchOptions options;
+    uint64_t epoch = 0;
+    RecordView rayGenRecord;
+    std::atomic<uint64_t> firstErrorIndex{~0ull};
+};
+
+struct ThreadState {
+    DispatchState* dispatch = nullptr;
+    uvec3 launchIndex{0u};
+    uint64_t linearIndex = 0;
+    DiagnosticLog log;
+    DispatchStats stats;
+    std::vector<Candidate> candidates;
+    uint64_t rayCounter = 0;
+    std::vector<Diagnostic> stopErrors;  // OnError::Stop: the errors that ended a launch
+};
+
+// Non-local exits (IS-10, AHS-4). They never carry errors and never leave the dispatcher.
+struct IgnoreHitSignal {};
+struct AcceptHitAndEndSearchSignal {};
+struct EndSearchSignal {};
+
+namespace {
+
+struct Site {
+    ShaderStage stage;
+    const std::string* exportName;
+    uint32_t depth;
+};
+
+Site siteOf(const Invocation& inv) {
+    static const std::string none;
+    return {inv.stage, inv.shader ? &inv.shader->name : &none, inv.depth};
+}
+
+Diagnostic locate(const ThreadState& ts, Diagnostic d, const Site& site) {
+    d.site = DiagnosticSite{ts.launchIndex, site.depth, site.stage, *site.exportName};
+    return d;
+}
+
+// An error at `site`. OnError::Stop: throws. Continue: records it and returns, and the
+// caller applies the fallback its rule documents.
+void raise(ThreadState& ts, const Site& site, const Diagnostic& d) {
+    Diagnostic located = locate(ts, d, site);
+    if (ts.dispatch->options.onError == OnError::Stop) throw DxrError(std::move(located));
+    ts.log.add(located, ts.linearIndex);
+}
+
+void warn(ThreadState& ts, const Site& site, const Diagnostic& d) { ts.log.add(locate(ts, d, site), ts.linearIndex); }
+
+std::string tableName(ProgramEntry::Kind kind) {
+    switch (kind) {
+        case ProgramEntry::Kind::HitGroup: return "hit-group table";
+        case ProgramEntry::Kind::Miss: return "miss shader table";
+        case ProgramEntry::Kind::Callable: return "callable shader table";
+        case ProgramEntry::Kind::RayGeneration: return "ray generation record";
+    }
+    return "table";
+}
+
+// Extra values a hit-group lookup diagnostic carries (IDX-11).
+struct HitLookupContext {
+    const HitGroupIndexTerms* terms = nullptr;
+    const HitInfo* hit = nullptr;
+    GeometryType geometryType = GeometryType::Triangles;
+};
+
+void addHitValues(DiagnosticBuilder& b, const HitLookupContext* h) {
+    if (!h || !h->terms) return;
+    const HitGroupIndexTerms& t = *h->terms;
+    b.value("I = R + M*G + C", std::to_string(t.rayContribution) + " + " + std::to_string(t.multiplier) + "*" +
+                                   std::to_string(t.geometryIndex) + " + " + std::to_string(t.instanceContribution) +
+                                   " = " + std::to_string(t.index));
+    if (h->hit) {
+        b.value("InstanceIndex", h->hit->instanceIndex)
+            .value("GeometryIndex", h->hit->geometryIndex)
+            .value("PrimitiveIndex", h->hit->primitiveIndex);
+    }
+}
+
+// Resolves the record at `index` of `table` (IDX-9..14, REC-7..11). Returns false when
+// the lookup failed in OnError::Continue mode (the caller treats it as a NULL record).
+bool lookupRecord(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
+                  const GpuVirtualAddressRangeAndStride& table, uint64_t index, RecordView& out,
+                  const HitLookupContext* hit = nullptr) {
+    const DispatchState& ds = *ts.dispatch;
+    const std::string name = tableName(kind);
+    out = RecordView{};
+    out.index = index;
+    const uint64_t offset = table.StrideInBytes * index;
+    out.address = table.StartAddress + offset;
+
+    if (table.StartAddress == 0 && table.SizeInBytes == 0) {
+        auto b = diag("IDX-11", "the " + name + " is missing (StartAddress 0, SizeInBytes 0) but a record is needed");
+        b.value("index", index);
+        addHitValues(b, hit);
+        raise(ts, site, b);
+        return false;
+    }
+    if (offset + kShaderIdentifierSizeInBytes > table.SizeInBytes) {
+        auto b = diag("IDX-11", "record index past the end of the " + name);
+        addHitValues(b, hit);
+        b.value("index", index)
+            .value("stride", table.StrideInBytes)
+            .value("record offset + 32", offset + kShaderIdentifierSizeInBytes, "SizeInBytes " + std::to_string(table.SizeInBytes))
+            .value("records in table", table.StrideInBytes ? table.SizeInBytes / table.StrideInBytes : 1);
+        raise(ts, site, b);
+        return false;
+    }
+    const GpuBuffer* buffer = ds.memory->find(out.address, kShaderIdentifierSizeInBytes);
+    const uint8_t* bytes = buffer ? buffer->bytes.data() + (out.address - buffer->base) : nullptr;
+    if (!bytes || !ds.memory->isWritten(out.address, kShaderIdentifierSizeInBytes)) {
+        auto b = diag("IDX-11", "the record's shader identifier at this index was never written (uninitialized record)");
+        addHitValues(b, hit);
+        b.value("index", index).hex("address", out.address);
+        raise(ts, site, b);
+        return false;
+    }
+    bool isNull = false;
+    const ProgramEntry* entry = ds.pipeline->resolve(bytes, isNull);
+    if (isNull) return true;  // REC-8: nothing runs for this purpose
+    if (!entry) {
+        auto b = diag("REC-8", "the " + name + " record holds an identifier that is not an export of the bound state object '" +
+                                   ds.pipeline->name() + "': it is " + StateObject::describeForeignIdentifier(bytes));
+        addHitValues(b, hit);
+        b.value("index", index).hex("address", out.address);
+        raise(ts, site, b);
+        return false;
+    }
+    if (entry->kind != kind) {
+        auto b = diag("IDX-13", "the " + name + " record holds " + std::string(toString(entry->kind)) + " '" +
+                                    entry->name + "', which does not belong in this table");
+        addHitValues(b, hit);
+        b.value("index", index);
+        raise(ts, site, b);
+        return false;
+    }
+    if (kind == ProgramEntry::Kind::HitGroup && hit) {
+        const bool procedural = hit->geometryType == GeometryType::ProceduralPrimitiveAABBs;
+        if (procedural != (entry->hitGroupType == HitGroupType::ProceduralPrimitive)) {
+            auto b = diag("IDX-14", "hit group '" + entry->name + "' (" +
+                                        (entry->hitGroupType == HitGroupType::ProceduralPrimitive ? "procedural" : "triangle") +
+                                        ") was selected for " + (procedural ? "AABB" : "triangle") + " geometry");
+            addHitValues(b, hit);
+            raise(ts, site, b);
+            return false;
+        }
+    }
+    const uint32_t layout = entry->localRootSignature ? entry->localRootSignature->recordSize() : kShaderIdentifierSizeInBytes;
+    if (table.StrideInBytes != 0 && table.StrideInBytes < layout) {
+        auto b = diag("IDX-10", "the " + name + " stride is smaller than the record of '" + entry->name + "'");
+        addHitValues(b, hit);
+        b.value("stride", table.StrideInBytes).value("record bytes (REC-5)", layout, "<= stride");
+        raise(ts, site, b);
+        return false;
+    }
+    const uint64_t available = table.StrideInBytes ? table.StrideInBytes : table.SizeInBytes - offset;
+    if (available < layout || offset + layout > table.SizeInBytes) {
+        auto b = diag(available < layout ? "REC-11" : "IDX-11",
+                      "the record of '" + entry->name + "' does not fit in the " + name);
+        addHitValues(b, hit);
+        b.value("record offset", offset)
+            .value("record bytes (REC-5)", layout)
+            .value("SizeInBytes", table.SizeInBytes);
+        raise(ts, site, b);
+        return false;
+    }
+    out.entry = entry;
+    out.arguments = bytes + kShaderIdentifierSizeInBytes;
+    out.argumentsWritten = buffer->written.data() + (out.address - buffer->base) + kShaderIdentifierSizeInBytes;
+    out.argumentBytesAvailable = std::min<uint64_t>(available, buffer->size() - (out.address - buffer->base)) -
+                                 kShaderIdentifierSizeInBytes;
+    return true;
+}
+
+// PIPE-6: the shader's global root signature must be the one bound for the dispatch.
+void checkGlobalSignature(ThreadState& ts, const Site& site, const ProgramEntry& entry) {
+    const DispatchState& ds = *ts.dispatch;
+    const RootSignature* bound = ds.global ? ds.global->signature().get() : nullptr;
+    if (entry.globalRootSignature && entry.globalRootSignature.get() != bound)
+        raise(ts, site,
+              diag("PIPE-6", "'" + entry.name + "' uses a global root signature other than the one bound for the dispatch")
+                  .value("shader's", entry.globalRootSignature->name())
+                  .value("bound", bound ? bound->name() : std::string("(none)")));
+}
+
+void checkPayload(ThreadState& ts, const Site& site, const ShaderExport& shader, TypeTag traced) {
+    if (!(shader.payload == traced))
+        raise(ts, site, diag("PAY-1", std::string(toString(shader.stage)) + " shader '" + shader.name +
+                                          "' declares another payload type than the TraceRay that invokes it")
+                            .value("TraceRay payload", traced.name() + " (" + std::to_string(traced.size) + " B)")
+                            .value("shader payload", shader.payload.name() + " (" + std::to_string(shader.payload.size) + " B)"));
+}
+
+void invoke(ThreadState& ts, Invocation& inv, void* payload, const void* attributes) {
+    ts.stats.invocations[size_t(inv.stage)]++;
+    ShaderContext ctx(inv);
+    inv.shader->function(ctx, payload, attributes);
+}
+
+bool isOpaque(uint32_t geometryFlags, uint32_t instanceFlags, uint32_t rayFlags) {  // OPQ-1
+    bool opaque = (geometryFlags & GEOMETRY_FLAG_OPAQUE) != 0;
+    if (instanceFlags & INSTANCE_FLAG_FORCE_OPAQUE) opaque = true;
+    if (instanceFlags & INSTANCE_FLAG_FORCE_NON_OPAQUE) opaque = false;
+    if (rayFlags & RAY_FLAG_FORCE_OPAQUE) opaque = true;
+    if (rayFlags & RAY_FLAG_FORCE_NON_OPAQUE) opaque = false;
+    return opaque;
+}
+
+void commit(RayState& rs, const HitInfo& hit) {  // TRV-4 step 4
+    rs.committed = true;
+    rs.committedHit = hit;
+    rs.tCurrent = hit.t;
+}
+
+enum class AnyHitOutcome { Accept, Ignore, AcceptAndEnd };
+
+AnyHitOutcome runAnyHit(ThreadState& ts, RayState& rs, const RecordView& record, HitInfo& candidate) {
+    Invocation inv;
+    inv.stage = ShaderStage::AnyHit;
+    inv.shader = record.entry->anyHit;
+    inv.record = &record;
+    inv.ray = &rs;
+    inv.hit = &candidate;
+    inv.dispatch = ts.dispatch;
+    inv.thread = &ts;
+    inv.depth = rs.depth;
+    checkPayload(ts, siteOf(inv), *inv.shader, rs.payloadType);
+    try {
+        invoke(ts, inv, rs.payload, candidate.attributes);
+    } catch (const IgnoreHitSignal&) {
+        return AnyHitOutcome::Ignore;
+    } catch (const AcceptHitAndEndSearchSignal&) {
+        return AnyHitOutcome::AcceptAndEnd;
+    }
+    return AnyHitOutcome::Accept;
+}
+
+// The state an intersection shader's ReportHit needs, reached through the invocation.
+struct ProceduralCandidate {
+    const RecordView* record = nullptr;
+    bool opaque = true;
+};
+
+}  // namespace
+
+// ReportHit (IS-3..IS-9): the body behind ShaderContext::ReportHit.
+bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attributes, TypeTag type,
+               const ProceduralCandidate& pc);
+
+namespace {
+thread_local const ProceduralCandidate* currentProcedural = nullptr;
+}
+
+bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attributes, TypeTag type,
+               const ProceduralCandidate& pc) {
+    ThreadState& ts = *inv.thread;
+    RayState& rs = *inv.ray;
+    const Site site = siteOf(inv);
+    const ProgramEntry& group = *pc.record->entry;
+    if (std::isnan(tHit)) {
+        raise(ts, site, diag("IS-3", "ReportHit called with a NaN THit; the hit is rejected").value("THit", tHit));
+        return false;
+    }
+    if (tHit < rs.ray.TMin || tHit > rs.tCurrent) return false;  // IS-3: closed interval
+    if (hitKind > kMaxProceduralHitKind)
+        raise(ts, site, diag("IS-4", "ReportHit HitKind outside 0..127 (254 and 255 mean triangle faces)")
+                            .value("HitKind", hitKind, "0..127"));
+    if (!(type == group.attributes)) {
+        raise(ts, site, diag("IS-5", "ReportHit attributes are not the type hit group '" + group.name + "' consumes")
+                            .value("reported", type.name() + " (" + std::to_string(type.size) + " B)")
+                            .value("expected", group.attributes.name() + " (" + std::to_string(group.attributes.size) + " B)"));
+        return false;
+    }
+    HitInfo candidate = *inv.hit;
+    candidate.t = tHit;
+    candidate.hitKind = hitKind;
+    candidate.attributeType = type;
+    std::memcpy(candidate.attributes, attributes, type.size);
+
+    if (!pc.opaque && group.anyHit) {  // IS-7: the AHS runs inside ReportHit
+        switch (runAnyHit(ts, rs, *pc.record, candidate)) {
+            case AnyHitOutcome::Ignore: return false;
+            case AnyHitOutcome::AcceptAndEnd: commit(rs, candidate); throw EndSearchSignal{};
+            case AnyHitOutcome::Accept: break;
+        }
+    }
+    commit(rs, candidate);  // IS-6
+    if (rs.effectiveFlags & RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH) throw EndSearchSignal{};  // FLAG-8
+    return true;
+}
+
+namespace {
+
+void processTriangle(ThreadState& ts, RayState& rs, const Candidate& c, const Site& site) {
+    if (!(rs.ray.TMin < c.t && c.t < rs.tCurrent)) return;  // TRV-2: open interval, current TCurrent
+    const BuiltInstance& inst = rs.tlas->instances()[c.instanceIndex];
+    const BuiltGeometry& geom = inst.blas->geometries()[c.geometryIndex];
+    const uint32_t instanceFlags = inst.desc.Flags;
+
+    // FACE-1..3: facing from the object-space winding; the instance transform never flips it.
+    const vec3* v = &geom.triangleVertices[size_t(c.primitiveIndex) * 3];
+    const dvec3 e1 = dvec3(v[1]) - dvec3(v[0]), e2 = dvec3(v[2]) - dvec3(v[0]);
+    const double facing = glm::dot(glm::cross(e1, e2), dvec3(c.objectRayDirection));
+    bool front = facing < 0.0;
+    if (instanceFlags & INSTANCE_FLAG_TRIANGLE_FRONT_COUNTERCLOCKWISE) front = !front;
+
+    if (!(instanceFlags & INSTANCE_FLAG_TRIANGLE_CULL_DISABLE)) {  // FLAG-10, FACE-5
+        if ((rs.effectiveFlags & RAY_FLAG_CULL_BACK_FACING_TRIANGLES) && !front) return;
+        if ((rs.effectiveFlags & RAY_FLAG_CULL_FRONT_FACING_TRIANGLES) && front) return;
+    }
+    const bool opaque = isOpaque(geom.flags, instanceFlags, rs.effectiveFlags);
+    if ((rs.effectiveFlags & RAY_FLAG_CULL_OPAQUE) && opaque) return;       // FLAG-11
+    if ((rs.effectiveFlags & RAY_FLAG_CULL_NON_OPAQUE) && !opaque) return;
+
+    HitInfo hit;
+    hit.instance = &inst;
+    hit.instanceIndex = c.instanceIndex;
+    hit.geometryIndex = c.geometryIndex;
+    hit.primitiveIndex = c.primitiveIndex;
+    hit.hitKind = front ? HIT_KIND_TRIANGLE_FRONT_FACE : HIT_KIND_TRIANGLE_BACK_FACE;  // FACE-4
+    hit.t = c.t;
+    hit.objectRayOrigin = c.objectRayOrigin;
+    hit.objectRayDirection = c.objectRayDirection;
+    const BuiltInTriangleIntersectionAttributes attributes{c.barycentrics};
+    hit.attributeType = typeTag<BuiltInTriangleIntersectionAttributes>();
+    std::memcpy(hit.attributes, &attributes, sizeof attributes);
+
+    bool endSearch = false;
+    if (!opaque) {  // OPQ-3: the record is needed only to find an AHS (IDX-12)
+        const HitGroupIndexTerms terms = hitGroupRecordIndex(rs.rayContribution, rs.multiplier, c.geometryIndex,
+                                                             inst.desc.InstanceContributionToHitGroupIndex);
+        HitLookupContext lookup{&terms, &hit, GeometryType::Triangles};
+        RecordView record;
+        if (lookupRecord(ts, site, ProgramEntry::Kind::HitGroup, ts.dispatch->desc->HitGroupTable, terms.index, record,
+                         &lookup) &&
+            record.entry && record.entry->anyHit) {
+            switch (runAnyHit(ts, rs, record, hit)) {
+                case AnyHitOutcome::Ignore: return;
+                case AnyHitOutcome::AcceptAndEnd: endSearch = true; break;
+                case AnyHitOutcome::Accept: break;
+            }
+        }
+    }
+    commit(rs, hit);
+    if (endSearch || (rs.effectiveFlags & RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH)) rs.searchEnded = true;  // FLAG-8
+}
+
+void processProcedural(ThreadState& ts, RayState& rs, const Candidate& c, const Site& site) {
+    if (c.key > rs.tCurrent) return;  // the box no longer overlaps [TMin, TCurrent]
+    const BuiltInstance& inst = rs.tlas->instances()[c.instanceIndex];
+    const BuiltGeometry& geom = inst.blas->geometries()[c.geometryIndex];
+    const bool opaque = isOpaque(geom.flags, inst.desc.Flags, rs.effectiveFlags);
+    if ((rs.effectiveFlags & RAY_FLAG_CULL_OPAQUE) && opaque) return;  // FLAG-11: before the IS
+    if ((rs.effectiveFlags & RAY_FLAG_CULL_NON_OPAQUE) && !opaque) return;
+
+    HitInfo box;
+    box.instance = &inst;
+    box.instanceIndex = c.instanceIndex;
+    box.geometryIndex = c.geometryIndex;
+    box.primitiveIndex = c.primitiveIndex;
+    box.objectRayOrigin = c.objectRayOrigin;
+    box.objectRayDirection = c.objectRayDirection;
+
+    const HitGroupIndexTerms terms = hitGroupRecordIndex(rs.rayContribution, rs.multiplier, c.geometryIndex,
+                                                         inst.desc.InstanceContributionToHitGroupIndex);
+    HitLookupContext lookup{&terms, &box, GeometryType::ProceduralPrimitiveAABBs};
+    RecordView record;
+    if (!lookupRecord(ts, site, ProgramEntry::Kind::HitGroup, ts.dispatch->desc->HitGroupTable, terms.index, record,
+                      &lookup))
+        return;
+    if (!record.entry) return;  // OPQ-4: a NULL hit group has no IS, so no hit
+
+    Invocation inv;
+    inv.stage = ShaderStage::Intersection;
+    inv.shader = record.entry->intersection;
+    inv.record = &record;
+    inv.ray = &rs;
+    inv.hit = &box;
+    inv.dispatch = ts.dispatch;
+    inv.thread = &ts;
+    inv.depth = rs.depth;
+    checkGlobalSignature(ts, siteOf(inv), *record.entry);
+    const ProceduralCandidate pc{&record, opaque};
+    const ProceduralCandidate* outer = currentProcedural;
+    currentProcedural = &pc;
+    try {
+        invoke(ts, inv, nullptr, nullptr);
+    } catch (const EndSearchSignal&) {
+        rs.searchEnded = true;  // IS-6/IS-7/FLAG-8: the IS ended at the accepting ReportHit
+    } catch (...) {
+        currentProcedural = outer;
+        throw;
+    }
+    currentProcedural = outer;
+}
+
+// Orders candidates per DispatchOptions::order (GEN-3).
+void orderCandidates(ThreadState& ts, RayState& rs) {
+    auto& cs = ts.candidates;
+    std::sort(cs.begin(), cs.end(), [](const Candidate& a, const Candidate& b) {
+        if (a.key != b.key) return a.key < b.key;
+        if (a.instanceIndex != b.instanceIndex) return a.instanceIndex < b.instanceIndex;
+        if (a.geometryIndex != b.geometryIndex) return a.geometryIndex < b.geometryIndex;
+        return a.primitiveIndex < b.primitiveIndex;
+    });
+    // One candidate per primitive: Embree may report a primitive more than once (AHS-6, IS-1).
+    cs.erase(std::unique(cs.begin(), cs.end(),
+                         [](const Candidate& a, const Candidate& b) {
+                             return a.instanceIndex == b.instanceIndex && a.geometryIndex == b.geometryIndex &&
+                                    a.primitiveIndex == b.primitiveIndex;
+                         }),
+             cs.end());
+    if (ts.dispatch->options.order != TraversalOrder::Adversarial) return;
+
+    std::mt19937_64 rng(ts.dispatch->options.adversarialSeed * 0x9E3779B97F4A7C15ull ^ (ts.linearIndex << 20) ^
+                        ts.rayCounter);
+    const size_t n = cs.size();
+    for (size_t i = 0; i < n; ++i) {
+        const Candidate& c = cs[i];
+        const BuiltGeometry& g = rs.tlas->instances()[c.instanceIndex].blas->geometries()[c.geometryIndex];
+        if (!(g.flags & GEOMETRY_FLAG_NO_DUPLICATE_ANYHIT_INVOCATION) && (rng() & 1)) cs.push_back(c);
+    }
+    std::shuffle(cs.begin(), cs.end(), rng);
+}
+
+void validateRay(ThreadState& ts, const Site& site, const RayDesc& ray, bool& ok) {
+    auto field = [&](const char* name, float v) {
+        if (std::isnan(v)) {
+            raise(ts, site, diag("RAY-5", std::string("RayDesc.") + name + " is NaN").value(name, v));
+            ok = false;
+        }
+    };
+    for (int c = 0; c < 3; ++c) {
+        static const char* o[3] = {"Origin.x", "Origin.y", "Origin.z"};
+        static const char* d[3] = {"Direction.x", "Direction.y", "Direction.z"};
+        field(o[c], ray.Origin[c]);
+        field(d[c], ray.Direction[c]);
+    }
+    field("TMin", ray.TMin);
+    field("TMax", ray.TMax);
+    if (!ok) return;
+    if (ray.TMin < 0.0f) {
+        raise(ts, site, diag("RAY-5", "RayDesc.TMin is negative").value("TMin", ray.TMin, ">= 0"));
+        ok = false;
+    } else if (ray.TMin > ray.TMax) {
+        raise(ts, site, diag("RAY-5", "RayDesc.TMin is greater than TMax").value("TMin", ray.TMin).value("TMax", ray.TMax, ">= TMin"));
+        ok = false;
+    }
+    if (std::isinf(ray.TMin))
+        warn(ts, site, warning("RAY-5", "RayDesc.TMin is infinite; no hit can follow").value("TMin", ray.TMin));
+    if (ray.Direction == vec3(0.0f))
+        warn(ts, site, warning("RAY-7", "RayDesc.Direction is the zero vector"));
+    else if (!allFinite(ray.Origin) || !allFinite(ray.Direction))
+        warn(ts, site, warning("RAY-7", "RayDesc has an infinite Origin or Direction component")
+                           .value("Origin", std::to_string(ray.Origin.x) + "," + std::to_string(ray.Origin.y) + "," + std::to_string(ray.Origin.z))
+                           .value("Direction", std::to_string(ray.Direction.x) + "," + std::to_string(ray.Direction.y) + "," + std::to_string(ray.Direction.z)));
+}
+
+// FLAG-2..5 on the effective flags; returns false (and has raised) when they are invalid.
+bool validateFlags(ThreadState& ts, const Site& site, uint32_t rayFlags, uint32_t pipelineFlags) {
+    const uint32_t eff = rayFlags | pipelineFlags;
+    auto fail = [&](const char* rule, const std::string& what) {
+        raise(ts, site, diag(rule, what)
+                            .value("TraceRay flags", rayFlagsToString(rayFlags))
+                            .value("pipeline flags", pipelineFlagsToString(pipelineFlags)));
+        return false;
+    };
+    const uint32_t opacity = eff & (RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_FORCE_NON_OPAQUE | RAY_FLAG_CULL_OPAQUE | RAY_FLAG_CULL_NON_OPAQUE);
+    if (opacity & (opacity - 1))
+        return fail(pipelineFlags ? "FLAG-5" : "FLAG-2",
+                    "at most one of FORCE_OPAQUE, FORCE_NON_OPAQUE, CULL_OPAQUE, CULL_NON_OPAQUE may be set");
+    if ((eff & RAY_FLAG_CULL_BACK_FACING_TRIANGLES) && (eff & RAY_FLAG_CULL_FRONT_FACING_TRIANGLES))
+        return fail(pipelineFlags ? "FLAG-5" : "FLAG-3", "CULL_BACK_FACING_TRIANGLES and CULL_FRONT_FACING_TRIANGLES are exclusive");
+    if ((eff & RAY_FLAG_SKIP_TRIANGLES) &&
+        (eff & (RAY_FLAG_CULL_BACK_FACING_TRIANGLES | RAY_FLAG_CULL_FRONT_FACING_TRIANGLES | RAY_FLAG_SKIP_PROCEDURAL_PRIMITIVES)))
+        return fail(pipelineFlags ? "FLAG-5" : "FLAG-4",
+                    "SKIP_TRIANGLES excludes CULL_*_FACING_TRIANGLES and SKIP_PROCEDURAL_PRIMITIVES");
+    return true;
+}
+
+}  // namespace
+
+// TraceRay (sections 4-10): validation, candidate gathering, the TRV-4 loop, then
+// the closest-hit or miss shader.
+void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags, uint32_t mask, uint32_t r,
+              uint32_t m, uint32_t missIndex, const RayDesc& ray, void* payload, TypeTag payloadType) {
+    ThreadState& ts = *caller.thread;
+    DispatchState& ds = *ts.dispatch;
+    const Site site = siteOf(caller);
+
+    if (caller.depth >= ds.pipeline->maxTraceRecursionDepth()) {  // LIM-2
+        raise(ts, site, diag("LIM-2", "TraceRay at the recursion limit: a call at depth == MaxTraceRecursionDepth removes the device")
+                            .value("depth", caller.depth, "< MaxTraceRecursionDepth " + std::to_string(ds.pipeline->maxTraceRecursionDepth()))
+                            .value("call chain", std::string(toString(caller.stage)) + " '" + *site.exportName + "'"));
+        return;  // fallback: the call does nothing
+    }
+    if (rayFlags & ~kDefinedRayFlags) {  // RAY-10
+        raise(ts, site, diag("RAY-10", "TraceRay flags set undefined bits")
+                            .hex("RayFlags", rayFlags)
+                            .hex("undefined bits", rayFlags & ~kDefinedRayFlags));
+        rayFlags &= kDefinedRayFlags;
+    }
+    if (!validateFlags(ts, site, rayFlags, ds.pipeline->pipelineFlags())) return;
+    bool rayOk = true;
+    validateRay(ts, site, ray, rayOk);
+    if (!rayOk) return;
+    if ((r & ~kRayContributionMask) || (m & ~kGeometryMultiplierMask))  // IDX-2
+        warn(ts, site, warning("IDX-2", "TraceRay index arguments have bits above the low 4; DXR ignores them")
+                           .value("RayContributionToHitGroupIndex", r, "0..15")
+                           .value("MultiplierForGeometryContributionToHitGroupIndex", m, "0..15"));
+
+    RayState rs;
+    rs.ray = ray;
+    rs.rayFlags = rayFlags;
+    rs.effectiveFlags = rayFlags | ds.pipeline->pipelineFlags();
+    rs.instanceInclusionMask = mask & kInstanceInclusionMaskBits;
+    rs.rayContribution = r;
+    rs.multiplier = m;
+    rs.missShaderIndex = missIndex;
+    rs.depth = caller.depth + 1;
+    rs.tCurrent = ray.TMax;
+    rs.payloadType = payloadType;
+
+    // RAY-9: the payload is passed by value.
+    alignas(16) uint8_t inlinePayload[256];
+    std::unique_ptr<uint8_t[]> heapPayload;
+    uint8_t* local = inlinePayload;
+    if (payloadType.size > sizeof inlinePayload) {
+        heapPayload.reset(new uint8_t[payloadType.size]);
+        local = heapPayload.get();
+    }
+    std::memcpy(local, payload, payloadType.size);
+    rs.payload = local;
+
+    ts.stats.raysTraced++;
+    if (ts.stats.raysPerDepth.size() <= rs.depth) ts.stats.raysPerDepth.resize(rs.depth + 1);
+    ts.stats.raysPerDepth[rs.depth]++;
+    ts.rayCounter++;
+
+    if (asAddress != 0) {
+        rs.tlas = ds.device->findTopLevelAS(asAddress);
+        if (!rs.tlas) {
+            const bool isBottom = ds.device->findBottomLevelAS(asAddress) != nullptr;
+            raise(ts, site, diag(isBottom ? "INST-10" : "RAY-1",
+                                 isBottom ? "TraceRay was given a BLAS; it needs a TLAS"
+                                          : "TraceRay was given an address that is not an acceleration structure")
+                                .hex("AccelerationStructure", asAddress));
+            return;
+        }
+        if (rs.tlas->checkedEpoch() != ds.epoch) {  // INST-8
+            for (size_t i = 0; i < rs.tlas->instances().size(); ++i) {
+                const BuiltInstance& inst = rs.tlas->instances()[i];
+                if (inst.blas && inst.blas->generation() != inst.blasGeneration) {
+                    raise(ts, site, diag("INST-8", "the TLAS was not rebuilt or updated after a BLAS it references was updated")
+                                        .value("InstanceIndex", i)
+                                        .hex("BLAS", inst.blas->address()));
+                    return;
+                }
+            }
+            rs.tlas->markChecked(ds.epoch);
+        }
+
+        // Gather (Embree broad phase + exact tests), order (GEN-3), then TRV-4 per candidate.
+        ts.candidates.clear();
+        GatherRequest gather;
+        gather.tlas = rs.tlas;
+        gather.origin = ray.Origin;
+        gather.direction = ray.Direction;
+        gather.tMin = ray.TMin;
+        gather.tMax = ray.TMax;
+        gather.instanceInclusionMask = rs.instanceInclusionMask;
+        gather.skipTriangles = (rs.effectiveFlags & RAY_FLAG_SKIP_TRIANGLES) != 0;            // FLAG-12
+        gather.skipProcedural = (rs.effectiveFlags & RAY_FLAG_SKIP_PROCEDURAL_PRIMITIVES) != 0;
+        gather.alternateEdgeRule = ds.options.order == TraversalOrder::Adversarial && (ds.options.adversarialSeed & 1);
+        gather.out = &ts.candidates;
+        gatherCandidates(gather);
+        ts.stats.candidates += ts.candidates.size();
+        orderCandidates(ts, rs);
+        // Nested TraceRays (from the CHS below) reuse ts.candidates: iterate over a copy only
+        // while shaders of this ray may run, which ends before the CHS starts.
+        for (size_t i = 0; i < ts.candidates.size() && !rs.searchEnded; ++i) {
+            const Candidate c = ts.candidates[i];
+            if (c.procedural) processProcedural(ts, rs, c, site);
+            else processTriangle(ts, rs, c, site);
+        }
+    }
+
+    // TRV-5, TRV-6: at most one CHS or one miss shader.
+    if (rs.committed) {
+        if (!(rs.effectiveFlags & RAY_FLAG_SKIP_CLOSEST_HIT_SHADER)) {  // FLAG-9
+            const HitInfo& hit = rs.committedHit;
+            const HitGroupIndexTerms terms =
+                hitGroupRecordIndex(r, m, hit.geometryIndex, hit.instance->desc.InstanceContributionToHitGroupIndex);
+            const BuiltGeometry& geom = hit.instance->blas->geometries()[hit.geometryIndex];
+            HitLookupContext lookup{&terms, &hit, geom.type};
+            RecordView record;
+            if (lookupRecord(ts, site, ProgramEntry::Kind::HitGroup, ds.desc->HitGroupTable, terms.index, record, &lookup) &&
+                record.entry && record.entry->closestHit) {
+                Invocation inv;
+                inv.stage = ShaderStage::ClosestHit;
+                inv.shader = record.entry->closestHit;
+                inv.record = &record;
+                inv.ray = &rs;
+                inv.hit = &rs.committedHit;
+                inv.dispatch = &ds;
+                inv.thread = &ts;
+                inv.depth = rs.depth;
+                checkGlobalSignature(ts, siteOf(inv), *record.entry);
+                checkPayload(ts, siteOf(inv), *inv.shader, payloadType);
+                invoke(ts, inv, rs.payload, rs.committedHit.attributes);
+            }
+        }
+    } else {
+        RecordView record;
+        if (lookupRecord(ts, site, ProgramEntry::Kind::Miss, ds.desc->MissShaderTable, missRecordIndex(missIndex), record) &&
+            record.entry) {
+            Invocation inv;
+            inv.stage = ShaderStage::Miss;
+            inv.shader = record.entry->shader;
+            inv.record = &record;
+            inv.ray = &rs;
+            inv.dispatch = &ds;
+            inv.thread = &ts;
+            inv.depth = rs.depth;
+            checkGlobalSignature(ts, siteOf(inv), *record.entry);
+            checkPayload(ts, siteOf(inv), *inv.shader, payloadType);
+            invoke(ts, inv, rs.payload, nullptr);
+        }
+    }
+    std::memcpy(payload, local, payloadType.size);
+}
+
+void callShader(Invocation& caller, uint32_t shaderIndex, void* parameters, TypeTag type) {
+    ThreadState& ts = *caller.thread;
+    DispatchState& ds = *ts.dispatch;
+    const Site site = siteOf(caller);
+    RecordView record;
+    if (!lookupRecord(ts, site, ProgramEntry::Kind::Callable, ds.desc->CallableShaderTable,
+                      callableRecordIndex(shaderIndex), record) ||
+        !record.entry)
+        return;  // REC-8: a NULL callable returns with the parameters unchanged
+    const ShaderExport& shader = *record.entry->shader;
+    if (!(shader.parameters == type)) {
+        raise(ts, site, diag("CALL-1", "CallShader parameters are not the type callable shader '" + shader.name + "' declares")
+                            .value("passed", type.name() + " (" + std::to_string(type.size) + " B)")
+                            .value("declared", shader.parameters.name() + " (" + std::to_string(shader.parameters.size) + " B)"));
+        return;
+    }
+    Invocation inv;
+    inv.stage = ShaderStage::Callable;
+    inv.shader = &shader;
+    inv.record = &record;
+    inv.dispatch = &ds;
+    inv.thread = &ts;
+    inv.depth = caller.depth;  // CALL-3: callables do not count toward recursion
+    checkGlobalSignature(ts, siteOf(inv), *record.entry);
+    alignas(16) uint8_t local[256];
+    std::unique_ptr<uint8_t[]> heap;
+    uint8_t* copy = local;
+    if (type.size > sizeof local) {
+        heap.reset(new uint8_t[type.size]);
+        copy = heap.get();
+    }
+    std::memcpy(copy, parameters, type.size);
+    invoke(ts, inv, copy, nullptr);
+    std::memcpy(parameters, copy, type.size);
+}
+
+const ProceduralCandidate* currentProceduralCandidate() { return currentProcedural; }
+
+}  // namespace detail
+
+// ---------------------------------------------------------------------------------------
+// ShaderContext intrinsics.
+
+namespace {
+using detail::Invocation;
+
+[[noreturn]] void stageError(Invocation& inv, const char* rule, const std::string& message) {
+    detail::ThreadState& ts = *inv.thread;
+    Diagnostic d = diag(rule, message).value("stage", toString(inv.stage));
+    d.site = DiagnosticSite{ts.launchIndex, inv.depth, inv.stage, inv.shader ? inv.shader->name : std::string()};
+    throw DxrError(std::move(d));  // misuse of the API always stops: there is no fallback
+}
+}  // namespace
+
+void ShaderContext::stageViolation(const char* intrinsic) const {
+    stageError(inv_, "SV-1", std::string(intrinsic) + "() may not be called from a " + std::string(toString(inv_.stage)) +
+                                 " shader");
+}
+
+uvec3 ShaderContext::DispatchRaysIndex() const { return inv_.thread->launchIndex; }
+
+uvec3 ShaderContext::DispatchRaysDimensions() const {
+    const DispatchRaysDesc& d = *inv_.dispatch->desc;
+    return {d.Width, d.Height, d.Depth};
+}
+
+float ShaderContext::RayTCurrent() const {
+    requireStage(kRay, "RayTCurrent");
+    switch (inv_.stage) {  // SV-5
+        case ShaderStage::Intersection: return inv_.ray->tCurrent;
+        case ShaderStage::AnyHit:
+        case ShaderStage::ClosestHit: return inv_.hit->t;
+        default: return inv_.ray->ray.TMax;
+    }
+}
+
+uint32_t ShaderContext::InstanceID() const { return hitInfo("InstanceID").instance->desc.InstanceID; }
+
+Matrix3x4 ShaderContext::ObjectToWorld3x4() const { return hitInfo("ObjectToWorld3x4").instance->objectToWorld; }
+std::array<std::array<float, 3>, 4> ShaderContext::ObjectToWorld4x3() const {
+    return transposed(hitInfo("ObjectToWorld4x3").instance->objectToWorld);
+}
+Matrix3x4 ShaderContext::WorldToObject3x4() const { return hitInfo("WorldToObject3x4").instance->worldToObject; }
+std::array<std::array<float, 3>, 4> ShaderContext::WorldToObject4x3() const {
+    return transposed(hitInfo("WorldToObject4x3").instance->worldToObject);
+}
+
+uint32_t ShaderContext::HitKind() const {
+    requireStage(bit(ShaderStage::AnyHit) | bit(ShaderStage::ClosestHit), "HitKind");
+    return inv_.hit->hitKind;
+}
+
+bool ShaderContext::reportHit(float tHit, uint32_t hitKind, const void* attributes, TypeTag type) {
+    requireStage(bit(ShaderStage::Intersection), "ReportHit");
+    return detail::reportHit(inv_, tHit, hitKind, attributes, type, *detail::currentProceduralCandidate());
+}
+
+void ShaderContext::IgnoreHit() {
+    requireStage(bit(ShaderStage::AnyHit), "IgnoreHit");
+    throw detail::IgnoreHitSignal{};
+}
+
+void ShaderContext::AcceptHitAndEndSearch() {
+    requireStage(bit(ShaderStage::AnyHit), "AcceptHitAndEndSearch");
+    throw detail::AcceptHitAndEndSearchSignal{};
+}
+
+void ShaderContext::traceRay(GpuVirtualAddress as, uint32_t flags, uint32_t mask, uint32_t r, uint32_t m, uint32_t miss,
+                             const RayDesc& ray, void* payload, TypeTag payloadType) {
+    if (!(bit(inv_.stage) & (bit(ShaderStage::RayGeneration) | bit(ShaderStage::ClosestHit) | bit(ShaderStage::Miss))))
+        stageError(inv_, "RAY-2", "TraceRay() may not be called from a " + std::string(toString(inv_.stage)) + " shader");
+    detail::traceRay(inv_, as, flags, mask, r, m, miss, ray, payload, payloadType);
+}
+
+void ShaderContext::callShader(uint32_t index, void* parameters, TypeTag type) {
+    if (!(bit(inv_.stage) & (bit(ShaderStage::RayGeneration) | bit(ShaderStage::ClosestHit) | bit(ShaderStage::Miss) |
+                             bit(ShaderStage::Callable))))
+        stageError(inv_, "CALL-2", "CallShader() may not be called from a " + std::string(toString(inv_.stage)) + " shader");
+    detail::callShader(inv_, index, parameters, type);
+}
+
+const uint8_t* ShaderContext::rootArgument(bool local, uint32_t parameter, size_t size, TypeTag type) const {
+    const RootSignature* signature = nullptr;
+    const uint8_t* bytes = nullptr;
+    const uint8_t* written = nullptr;
+    uint64_t available = 0;
+    if (local) {
+        if (inv_.record && inv_.record->entry) signature = inv_.record->entry->localRootSignature.get();
+        if (signature) {
+            bytes = inv_.record->arguments;
+            written = inv_.record->argumentsWritten;
+            available = inv_.record->argumentBytesAvailable;
+        }
+    } else if (inv_.dispatch->global) {
+        signature = inv_.dispatch->global->signature().get();
+        bytes = inv_.dispatch->global->bytes().data();
+        written = inv_.dispatch->global->setMask().data();
+        available = inv_.dispatch->global->bytes().size();
+    }
+    const char* which = local ? "local" : "global";
+    if (!signature)
+        stageError(inv_, local ? "REC-11" : "PIPE-6",
+                   std::string("shader reads ") + which + " root parameter " + std::to_string(parameter) + " but has no " +
+                       which + " root signature");
+    if (parameter >= signature->parameterCount())
+        stageError(inv_, local ? "REC-11" : "PIPE-6",
+                   std::string(which) + " root signature '" + signature->name() + "' has " +
+                       std::to_string(signature->parameterCount()) + " parameters; the shader reads parameter " +
+                       std::to_string(parameter));
+    const RootParameter& p = signature->parameter(parameter);
+    const bool wantConstants = type.valid();
+    if (wantConstants != (p.parameterType == RootParameterType::Constants32Bit) ||
+        (wantConstants && size != p.num32BitValues * 4u))
+        stageError(inv_, "REC-11",
+                   std::string(which) + " root parameter " + std::to_string(parameter) + " of '" + signature->name() +
+                       "' is " + std::string(toString(p.parameterType)) +
+                       (p.parameterType == RootParameterType::Constants32Bit ? " (" + std::to_string(p.num32BitValues * 4) + " bytes)" : std::string()) +
+                       "; the shader reads it as " + (wantConstants ? type.name() + " (" + std::to_string(size) + " bytes)" : std::string("a descriptor")));
+    const uint32_t offset = signature->argumentOffset(parameter) - kShaderIdentifierSizeInBytes;
+    if (offset + size > available)
+        stageError(inv_, "REC-11", std::string(which) + " root parameter " + std::to_string(parameter) +
+                                       " lies past the bytes available to the record");
+    if (!std::all_of(written + offset, written + offset + size, [](uint8_t w) { return w != 0; }))
+        stageError(inv_, "REC-7", std::string("shader reads ") + which + " root parameter " + std::to_string(parameter) +
+                                      " of '" + signature->name() + "', whose bytes were never written");
+    return bytes + offset;
+}
+
+GpuVirtualAddress ShaderContext::localRootDescriptor(uint32_t parameter) const {
+    GpuVirtualAddress va;
+    std::memcpy(&va, rootArgument(true, parameter, 8, TypeTag{}), 8);
+    return va;
+}
+
+GpuVirtualAddress ShaderContext::globalRootDescriptor(uint32_t parameter) const {
+    GpuVirtualAddress va;
+    std::memcpy(&va, rootArgument(false, parameter, 8, TypeTag{}), 8);
+    return va;
+}
+
+GpuDescriptorHandle ShaderContext::globalDescriptorTable(uint32_t parameter) const { return globalRootDescriptor(parameter); }
+
+const uint8_t* ShaderContext::readMemory(GpuVirtualAddress address, uint64_t size) const {
+    try {
+        return inv_.dispatch->memory->read(address, size, "shader memory read");
+    } catch (const Error& e) {
+        stageError(inv_, "GEN-1", e.what());
+    }
+}
+
+Image& ShaderContext::rwTexture2D(GpuDescriptorHandle tableHandle, uint32_t offset) const {
+    const DescriptorHeap* heap = inv_.dispatch->device->findDescriptorHeap(tableHandle);
+    if (!heap) stageError(inv_, "GEN-1", "descriptor handle is not in any descriptor heap");
+    const Descriptor& d = heap->at(tableHandle, offset);
+    if (d.kind != Descriptor::Kind::Texture2D || d.type != DescriptorRangeType::UAV)
+        stageError(inv_, "GEN-1", "descriptor " + std::to_string(offset) + " of heap '" + heap->name() +
+                                      "' is not a Texture2D UAV (RWTexture2D)");
+    return *d.texture;
+}
+
+// ---------------------------------------------------------------------------------------
+// DispatchRays.
+
+namespace {
+
+// Locks every table the dispatch reads for its whole duration (REC-12).
+class TableLock {
+public:
+    TableLock(GpuMemory& memory, std::vector<GpuVirtualAddress> addresses) : memory_(memory), addresses_(std::move(addresses)) {
+        for (auto a : addresses_) memory_.setLocked(a, true);
+    }
+    ~TableLock() {
+        for (auto a : addresses_) memory_.setLocked(a, false);
+    }
+    TableLock(const TableLock&) = delete;
+    TableLock& operator=(const TableLock&) = delete;
+
+private:
+    GpuMemory& memory_;
+    std::vector<GpuVirtualAddress> addresses_;
+};
+
+void checkTableRange(const char* name, GpuVirtualAddress start, uint64_t size, uint64_t stride, bool hasStride) {
+    if (start == 0 && size == 0) return;
+    if (start % kShaderTableByteAlignment)
+        throw DxrError(diag("REC-2", std::string(name) + " StartAddress is not a multiple of 64")
+                           .hex("StartAddress", start)
+                           .value("StartAddress % 64", start % kShaderTableByteAlignment, "0"));
+    if (hasStride && (stride % kShaderRecordByteAlignment || stride > kMaxShaderRecordStride))
+        throw DxrError(diag("REC-3", std::string(name) + " StrideInBytes must be a multiple of 32 in [0, 4096]")
+                           .value("StrideInBytes", stride, "multiple of 32, <= 4096"));
+}
+
+}  // namespace
+
+DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObjectPtr& pipeline,
+                                    const GlobalRootArguments* globalArguments, const DispatchOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
+    if (!pipeline)
+        throw DxrError(diag("RGS-3", "DispatchRays without a bound ray-tracing pipeline state object"));
+    const uint64_t threads = uint64_t(desc.Width) * desc.Height * desc.Depth;
+    if (threads > kMaxRayGenerationShaderThreads)
+        throw DxrError(diag("RGS-1", "DispatchRays launches too many threads")
+                           .value("Width*Height*Depth", threads, std::to_string(kMaxRayGenerationShaderThreads))
+                           .value("Width", desc.Width)
+                           .value("Height", desc.Height)
+                           .value("Depth", desc.Depth));
+    checkTableRange("RayGenerationShaderRecord", desc.RayGenerationShaderRecord.StartAddress,
+                    desc.RayGenerationShaderRecord.SizeInBytes, 0, false);
+    checkTableRange("MissShaderTable", desc.MissShaderTable.StartAddress, desc.MissShaderTable.SizeInBytes,
+                    desc.MissShaderTable.StrideInBytes, true);
+    checkTableRange("HitGroupTable", desc.HitGroupTable.StartAddress, desc.HitGroupTable.SizeInBytes,
+                    desc.HitGroupTable.StrideInBytes, true);
+    checkTableRange("CallableShaderTable", desc.CallableShaderTable.StartAddress, desc.CallableShaderTable.SizeInBytes,
+                    desc.CallableShaderTable.StrideInBytes, true);
+    for (auto [name, range] : {std::pair{"MissShaderTable", GpuVirtualAddressRange{desc.MissShaderTable.StartAddress, desc.MissShaderTable.SizeInBytes}},
+                               std::pair{"HitGroupTable", GpuVirtualAddressRange{desc.HitGroupTable.StartAddress, desc.HitGroupTable.SizeInBytes}},
+                               std::pair{"CallableShaderTable", GpuVirtualAddressRange{desc.CallableShaderTable.StartAddress, desc.CallableShaderTable.SizeInBytes}},
+                               std::pair{"RayGenerationShaderRecord", desc.RayGenerationShaderRecord}}) {
+        if (range.SizeInBytes && !memory_.find(range.StartAddress, range.SizeInBytes))
+            throw DxrError(diag("IDX-11", std::string(name) + " range is not inside one GPU buffer")
+                               .hex("StartAddress", range.StartAddress)
+                               .value("SizeInBytes", range.SizeInBytes));
+    }
+    if (globalArguments && globalArguments->signature()->isLocal())
+        throw DxrError(diag("PIPE-7", "the root signature bound for the dispatch is a local root signature")
+                           .value("signature", globalArguments->signature()->name()));
+
+    detail::DispatchState ds;
+    ds.device = this;
+    ds.memory = &memory_;
+    ds.pipeline = pipeline.get();
+    ds.desc = &desc;
+    ds.global = globalArguments;
+    ds.options = options;
+    ds.epoch = epoch_.load();
+
+    // The ray generation record (IDX-9, IDX-13), resolved once for every thread.
+    {
+        detail::ThreadState probe;
+        probe.dispatch = &ds;
+        static const std::string none;
+        const detail::Site site{ShaderStage::RayGeneration, &none, 0};
+        DispatchOptions stop = options;
+        stop.onError = OnError::Stop;
+        ds.options = stop;
+        const GpuVirtualAddressRangeAndStride rg{desc.RayGenerationShaderRecord.StartAddress,
+                                                 desc.RayGenerationShaderRecord.SizeInBytes, 0};
+        if (rg.StartAddress == 0 || rg.SizeInBytes < kShaderIdentifierSizeInBytes)
+            throw DxrError(diag("IDX-9", "RayGenerationShaderRecord must hold at least the 32-byte identifier")
+                               .hex("StartAddress", rg.StartAddress)
+                               .value("SizeInBytes", rg.SizeInBytes, ">= 32"));
+        detail::lookupRecord(probe, site, ProgramEntry::Kind::RayGeneration, rg, 0, ds.rayGenRecord);
+        ds.options = options;
+        if (ds.rayGenRecord.entry && ds.rayGenRecord.entry->localRootSignature &&
+            rg.SizeInBytes < ds.rayGenRecord.entry->localRootSignature->recordSize())
+            throw DxrError(diag("IDX-9", "RayGenerationShaderRecord.SizeInBytes does not cover the identifier and local root arguments")
+                               .value("SizeInBytes", rg.SizeInBytes,
+                                      ">= " + std::to_string(ds.rayGenRecord.entry->localRootSignature->recordSize())));
+    }
+    DispatchResult result;
+    if (!ds.rayGenRecord.entry || threads == 0) {  // REC-8: NULL ray generation; RGS-1: zero size
+        result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        return result;
+    }
+
+    TableLock lock(memory_, {desc.RayGenerationShaderRecord.StartAddress, desc.MissShaderTable.StartAddress,
+                             desc.HitGroupTable.StartAddress, desc.CallableShaderTable.StartAddress});
+    tbb::enumerable_thread_specific<detail::ThreadState> threadStates([&] {
+        detail::ThreadState ts;
+        ts.dispatch = &ds;
+        ts.candidates.reserve(64);
+        return ts;
+    });
+
+    const uint32_t tile = std::max(1u, options.tileSize);
+    const int arenaThreads = options.threads ? int(options.threads) : tbb::task_arena::automatic;
+    tbb::task_arena arena(arenaThreads);
+    arena.execute([&] {
+        tbb::parallel_for(
+            tbb::blocked_range2d<uint32_t>(0, desc.Height, tile, 0, desc.Width, tile),
+            [&](const tbb::blocked_range2d<uint32_t>& range) {
+                detail::ThreadState& ts = threadStates.local();
+                for (uint32_t z = 0; z < desc.Depth; ++z) {
+                    for (uint32_t y = range.rows().begin(); y < range.rows().end(); ++y) {
+                        for (uint32_t x = range.cols().begin(); x < range.cols().end(); ++x) {
+                            ts.launchIndex = uvec3(x, y, z);
+                            ts.linearIndex = (uint64_t(z) * desc.Height + y) * desc.Width + x;
+                            if (ts.linearIndex > ds.firstErrorIndex.load(std::memory_order_relaxed)) continue;
+                            ts.rayCounter = 0;
+                            detail::Invocation inv;
+                            inv.stage = ShaderStage::RayGeneration;
+                            inv.shader = ds.rayGenRecord.entry->shader;
+                            inv.record = &ds.rayGenRecord;
+                            inv.dispatch = &ds;
+                            inv.thread = &ts;
+                            inv.depth = 0;
+                            try {
+                                detail::checkGlobalSignature(ts, detail::siteOf(inv), *ds.rayGenRecord.entry);
+                                detail::invoke(ts, inv, nullptr, nullptr);
+                            } catch (const DxrError& e) {
+                                ts.stopErrors.push_back(e.diagnostic());
+                                uint64_t seen = ds.firstErrorIndex.load();
+                                while (ts.linearIndex < seen && !ds.firstErrorIndex.compare_exchange_weak(seen, ts.linearIndex)) {
+                                }
+                            } catch (const Error& e) {
+                                Diagnostic d = diag("GEN-1", e.what());
+                                d.site = DiagnosticSite{ts.launchIndex, 0, ShaderStage::RayGeneration, inv.shader->name};
+                                ts.stopErrors.push_back(d);
+                                uint64_t seen = ds.firstErrorIndex.load();
+                                while (ts.linearIndex < seen && !ds.firstErrorIndex.compare_exchange_weak(seen, ts.linearIndex)) {
+                                }
+                            }
+                        }
+                    }
+                }
+                if (options.progress) options.progress->advance(range.rows().size() * range.cols().size());
+            });
+    });
+
+    std::vector<Diagnostic> errors;
+    for (auto& ts : threadStates) {
+        result.diagnostics.merge(ts.log);
+        result.stats.merge(ts.stats);
+        errors.insert(errors.end(), ts.stopErrors.begin(), ts.stopErrors.end());
+    }
+    if (!errors.empty()) {
+        auto linear = [&](const Diagnostic& d) {
+            const uvec3 l = d.site ? d.site->launchIndex : uvec3(0u);
+            return (uint64_t(l.z) * desc.Height + l.y) * desc.Width + l.x;
+        };
+        auto first = std::min_element(errors.begin(), errors.end(),
+                                      [&](const Diagnostic& a, const Diagnostic& b) { return linear(a) < linear(b); });
+        throw DxrError(*first);
+    }
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+}  // namespace refray::dxr

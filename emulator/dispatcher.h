@@ -1,0 +1,55 @@
+// DispatchRays options and results (the dispatcher itself is Device::dispatchRays).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/progress.h"
+#include "emulator/validation.h"
+
+namespace refray::dxr {
+
+// GEN-3: the order in which candidates meet the DXR rules, within what the spec allows.
+enum class TraversalOrder : uint8_t {
+    // Default, deterministic: candidates in increasing order of their key (a triangle's t,
+    // an AABB's entry t into [TMin, TCurrent]); ties by InstanceIndex, GeometryIndex,
+    // PrimitiveIndex. A box whose entry lies beyond TCurrent when its turn comes is
+    // skipped (it no longer overlaps the interval). One IS call per enumerated box.
+    Ordered,
+    // Seeded adversarial: candidates shuffled; geometry without
+    // NO_DUPLICATE_ANYHIT_INVOCATION sees candidates presented twice (duplicate IS and
+    // AHS calls, AHS-6, IS-1); shared edges use the alternate ownership rule (TRI-4).
+    Adversarial,
+};
+
+enum class OnError : uint8_t {
+    Stop,      // GEN-1 default: the first error (lowest launch index) ends the dispatch
+    Continue,  // record every error and apply the fallback its rule documents
+};
+
+struct DispatchOptions {
+    uint32_t threads = 0;  // 0: every hardware thread
+    uint32_t tileSize = 8;
+    OnError onError = OnError::Stop;
+    TraversalOrder order = TraversalOrder::Ordered;
+    uint64_t adversarialSeed = 0;
+    Progress* progress = nullptr;  // advanced once per tile
+};
+
+struct DispatchStats {
+    uint64_t raysTraced = 0;
+    std::vector<uint64_t> raysPerDepth;  // index = depth of the invoked shaders (1 = primary)
+    std::array<uint64_t, 6> invocations{};  // by ShaderStage
+    uint64_t candidates = 0;
+    void merge(const DispatchStats& other);
+    uint64_t invocationsOf(ShaderStage s) const { return invocations[size_t(s)]; }
+};
+
+struct DispatchResult {
+    DiagnosticLog diagnostics;  // warnings, plus the errors in OnError::Continue mode
+    DispatchStats stats;
+    double seconds = 0.0;
+};
+
+}  // namespace refray::dxr

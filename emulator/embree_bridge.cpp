@@ -1,0 +1,225 @@
+#include "emulator/embree_bridge.h"
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+
+#include <embree3/rtcore.h>
+
+#include "core/error.h"
+#include "emulator/intersection.h"
+
+namespace refray::dxr::detail {
+
+struct EmbreeDeviceImpl {
+    RTCDevice device = nullptr;
+    std::mutex errorMutex;
+    std::string firstError;
+};
+
+namespace {
+
+void onEmbreeError(void* userPtr, RTCError code, const char* message) {
+    auto* impl = static_cast<EmbreeDeviceImpl*>(userPtr);
+    std::lock_guard lock(impl->errorMutex);
+    if (impl->firstError.empty())
+        impl->firstError = "Embree error " + std::to_string(int(code)) + ": " + (message ? message : "(no message)");
+}
+
+void throwIfEmbreeFailed(EmbreeDeviceImpl& impl, const char* what) {
+    std::lock_guard lock(impl.errorMutex);
+    if (!impl.firstError.empty()) {
+        std::string message = std::string(what) + ": " + impl.firstError;
+        impl.firstError.clear();
+        throw Error(message);
+    }
+}
+
+}  // namespace
+
+EmbreeDevice::EmbreeDevice() : impl_(std::make_unique<EmbreeDeviceImpl>()) {
+    impl_->device = rtcNewDevice("verbose=0");
+    REFRAY_CHECK(impl_->device, "cannot create an Embree device (error " << int(rtcGetDeviceError(nullptr)) << ")");
+    rtcSetDeviceErrorFunction(impl_->device, onEmbreeError, impl_.get());
+}
+
+EmbreeDevice::~EmbreeDevice() {
+    if (impl_->device) rtcReleaseDevice(impl_->device);
+}
+
+// What a user geometry's callbacks need: the built geometry and its index.
+struct UserGeometry {
+    const BuiltGeometry* geometry = nullptr;
+    uint32_t geometryIndex = 0;
+};
+
+EmbreeScene::~EmbreeScene() {
+    if (scene) rtcReleaseScene(static_cast<RTCScene>(scene));
+}
+
+namespace {
+
+// The extended intersect context (Embree's idiom): per-ray state rides along, never globals.
+struct GatherContext {
+    RTCIntersectContext embree;  // must be first
+    const GatherRequest* request;
+};
+
+// Enlarge bounds by a relative margin so Embree's float traversal never culls a box
+// that refray's exact test would touch (BLAS-7 allows conservative boxes).
+void enlarge(RTCBounds& b) {
+    const float ex = b.upper_x - b.lower_x, ey = b.upper_y - b.lower_y, ez = b.upper_z - b.lower_z;
+    const float scale = std::max({std::fabs(b.lower_x), std::fabs(b.lower_y), std::fabs(b.lower_z), std::fabs(b.upper_x),
+                                  std::fabs(b.upper_y), std::fabs(b.upper_z), ex, ey, ez});
+    const float margin = scale * 1e-5f + 1e-30f;
+    b.lower_x -= margin;
+    b.lower_y -= margin;
+    b.lower_z -= margin;
+    b.upper_x += margin;
+    b.upper_y += margin;
+    b.upper_z += margin;
+}
+
+void boundsCallback(const RTCBoundsFunctionArguments* args) {
+    const auto* user = static_cast<const UserGeometry*>(args->geometryUserPtr);
+    const BuiltGeometry& g = *user->geometry;
+    RTCBounds& b = *args->bounds_o;
+    const uint32_t prim = args->primID;
+    if (!g.active[prim]) {
+        // Inactive (DEGEN-1): an empty box, which Embree's builder drops.
+        b.lower_x = b.lower_y = b.lower_z = 1.0f;
+        b.upper_x = b.upper_y = b.upper_z = -1.0f;
+        return;
+    }
+    if (g.type == GeometryType::Triangles) {
+        const vec3* v = &g.triangleVertices[size_t(prim) * 3];
+        const vec3 lo = glm::min(v[0], glm::min(v[1], v[2])), hi = glm::max(v[0], glm::max(v[1], v[2]));
+        b.lower_x = lo.x, b.lower_y = lo.y, b.lower_z = lo.z;
+        b.upper_x = hi.x, b.upper_y = hi.y, b.upper_z = hi.z;
+    } else {
+        const RaytracingAABB& a = g.aabbs[prim];
+        b.lower_x = a.MinX, b.lower_y = a.MinY, b.lower_z = a.MinZ;
+        b.upper_x = a.MaxX, b.upper_y = a.MaxY, b.upper_z = a.MaxZ;
+    }
+    enlarge(b);
+}
+
+void intersectCallback(const RTCIntersectFunctionNArguments* args) {
+    if (!args->valid[0]) return;
+    const auto* ctx = reinterpret_cast<const GatherContext*>(args->context);
+    const GatherRequest& req = *ctx->request;
+    const auto* user = static_cast<const UserGeometry*>(args->geometryUserPtr);
+    const BuiltGeometry& g = *user->geometry;
+    const uint32_t prim = args->primID;
+    if (!g.active[prim]) return;
+    const bool triangles = g.type == GeometryType::Triangles;
+    if (triangles ? req.skipTriangles : req.skipProcedural) return;
+
+    // refray's own object-space ray (TRV-8): the exact inverse, not Embree's.
+    const uint32_t instanceIndex = args->context->instID[0];
+    const BuiltInstance& inst = req.tlas->instances()[instanceIndex];
+    Candidate c;
+    c.instanceIndex = instanceIndex;
+    c.geometryIndex = user->geometryIndex;
+    c.primitiveIndex = prim;
+    c.objectRayOrigin = inst.worldToObject.transformPoint(req.origin);
+    c.objectRayDirection = inst.worldToObject.transformVector(req.direction);
+
+    if (triangles) {
+        const vec3* v = &g.triangleVertices[size_t(prim) * 3];
+        auto hit = intersectTriangle(c.objectRayOrigin, c.objectRayDirection, v[0], v[1], v[2], req.alternateEdgeRule);
+        if (!hit || !(hit->t >= req.tMin && hit->t <= req.tMax)) return;
+        c.t = c.key = hit->t;
+        c.barycentrics = hit->barycentrics;
+    } else {
+        auto slab = intersectAABB(c.objectRayOrigin, c.objectRayDirection, g.aabbs[prim], req.tMin, req.tMax);
+        if (!slab) return;
+        c.procedural = true;
+        c.key = slab->tEnter;
+    }
+    req.out->push_back(c);
+}
+
+void occludedCallback(const RTCOccludedFunctionNArguments*) {
+    // refray always gathers with rtcIntersect1; occlusion queries never reach user geometry.
+}
+
+}  // namespace
+
+std::unique_ptr<EmbreeScene> buildBottomLevelScene(EmbreeDevice& device, const BottomLevelAS& blas) {
+    auto& impl = device.impl();
+    auto out = std::make_unique<EmbreeScene>();
+    RTCScene scene = rtcNewScene(impl.device);
+    out->scene = scene;
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+    const auto& geometries = blas.geometries();
+    for (uint32_t i = 0; i < geometries.size(); ++i) {
+        auto user = std::make_unique<UserGeometry>();
+        user->geometry = &geometries[i];
+        user->geometryIndex = i;
+        RTCGeometry geom = rtcNewGeometry(impl.device, RTC_GEOMETRY_TYPE_USER);
+        rtcSetGeometryUserPrimitiveCount(geom, geometries[i].primitiveCount());
+        rtcSetGeometryMask(geom, 0xFFFFFFFFu);
+        rtcSetGeometryUserData(geom, user.get());
+        rtcSetGeometryBoundsFunction(geom, boundsCallback, nullptr);
+        rtcSetGeometryIntersectFunction(geom, intersectCallback);
+        rtcSetGeometryOccludedFunction(geom, occludedCallback);
+        rtcCommitGeometry(geom);
+        rtcAttachGeometryByID(scene, geom, i);
+        rtcReleaseGeometry(geom);
+        out->userGeometries.push_back(std::move(user));
+    }
+    rtcCommitScene(scene);
+    throwIfEmbreeFailed(impl, "building a bottom-level acceleration structure");
+    return out;
+}
+
+std::unique_ptr<EmbreeScene> buildTopLevelScene(EmbreeDevice& device, const TopLevelAS& tlas) {
+    auto& impl = device.impl();
+    auto out = std::make_unique<EmbreeScene>();
+    RTCScene scene = rtcNewScene(impl.device);
+    out->scene = scene;
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_ROBUST);
+    const auto& instances = tlas.instances();
+    for (uint32_t i = 0; i < instances.size(); ++i) {
+        const BuiltInstance& inst = instances[i];
+        if (!inst.blas) continue;  // inactive: keeps its index, never intersected (INST-6, DEGEN-4)
+        RTCGeometry geom = rtcNewGeometry(impl.device, RTC_GEOMETRY_TYPE_INSTANCE);
+        rtcSetGeometryInstancedScene(geom, static_cast<RTCScene>(inst.blas->embree().scene));
+        rtcSetGeometryMask(geom, inst.desc.InstanceMask);
+        rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &inst.desc.Transform[0][0]);
+        rtcCommitGeometry(geom);
+        rtcAttachGeometryByID(scene, geom, i);
+        rtcReleaseGeometry(geom);
+    }
+    rtcCommitScene(scene);
+    throwIfEmbreeFailed(impl, "building a top-level acceleration structure");
+    return out;
+}
+
+void gatherCandidates(const GatherRequest& request) {
+    GatherContext ctx;
+    rtcInitIntersectContext(&ctx.embree);
+    ctx.request = &request;
+
+    RTCRayHit rayhit;
+    rayhit.ray.org_x = request.origin.x;
+    rayhit.ray.org_y = request.origin.y;
+    rayhit.ray.org_z = request.origin.z;
+    rayhit.ray.dir_x = request.direction.x;
+    rayhit.ray.dir_y = request.direction.y;
+    rayhit.ray.dir_z = request.direction.z;
+    // Embree's own interval is widened a little: the exact tests decide, Embree only culls.
+    rayhit.ray.tnear = std::max(0.0f, request.tMin - (std::fabs(request.tMin) * 1e-5f + 1e-30f));
+    rayhit.ray.tfar = std::isinf(request.tMax) ? request.tMax : request.tMax + std::fabs(request.tMax) * 1e-5f + 1e-30f;
+    rayhit.ray.time = 0.0f;
+    rayhit.ray.mask = request.instanceInclusionMask & 0xFF;
+    rayhit.ray.id = 0;
+    rayhit.ray.flags = 0;
+    rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(static_cast<RTCScene>(request.tlas->embree().scene), &ctx.embree, &rayhit);
+}
+
+}  // namespace refray::dxr::detail

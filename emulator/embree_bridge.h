@@ -1,0 +1,74 @@
+// The only place that sees Embree (style rule 2). BLAS = an Embree scene of user
+// geometries (one per DXR geometry, geometry id = GeometryIndex); TLAS = an Embree
+// scene of instances (instance id = InstanceIndex, geometry mask = InstanceMask).
+//
+// Embree is the broad phase: it walks its BVH and calls back for every primitive whose
+// (slightly enlarged) bounds the ray touches. The callbacks run refray's own exact tests
+// (intersection.h) and record candidates; the dispatcher then applies every DXR rule to
+// them in a documented order. Nothing thrown ever crosses Embree (style rule 9).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "emulator/acceleration_structure.h"
+
+namespace refray::dxr::detail {
+
+struct EmbreeDeviceImpl;
+
+class EmbreeDevice {
+public:
+    EmbreeDevice();
+    ~EmbreeDevice();
+    EmbreeDevice(const EmbreeDevice&) = delete;
+    EmbreeDevice& operator=(const EmbreeDevice&) = delete;
+    EmbreeDeviceImpl& impl() { return *impl_; }
+
+private:
+    std::unique_ptr<EmbreeDeviceImpl> impl_;
+};
+
+struct EmbreeScene {
+    void* scene = nullptr;  // RTCScene
+    std::vector<std::unique_ptr<struct UserGeometry>> userGeometries;
+    ~EmbreeScene();
+};
+
+std::unique_ptr<EmbreeScene> buildBottomLevelScene(EmbreeDevice& device, const BottomLevelAS& blas);
+std::unique_ptr<EmbreeScene> buildTopLevelScene(EmbreeDevice& device, const TopLevelAS& tlas);
+
+// A potential hit found by the broad phase and confirmed by the exact test.
+struct Candidate {
+    float key = 0.0f;  // ordering key: the triangle t, or the AABB entry t
+    uint32_t instanceIndex = 0;
+    uint32_t geometryIndex = 0;
+    uint32_t primitiveIndex = 0;
+    bool procedural = false;
+    float t = 0.0f;           // triangles
+    vec2 barycentrics{0.0f};  // triangles
+    vec3 objectRayOrigin{0.0f};
+    vec3 objectRayDirection{0.0f};
+};
+
+struct GatherRequest {
+    const TopLevelAS* tlas = nullptr;
+    vec3 origin{0.0f};
+    vec3 direction{0.0f};
+    float tMin = 0.0f;
+    float tMax = 0.0f;
+    uint32_t instanceInclusionMask = 0xFF;
+    bool skipTriangles = false;
+    bool skipProcedural = false;
+    bool alternateEdgeRule = false;
+    std::vector<Candidate>* out = nullptr;
+};
+
+// Appends every primitive of an active, unmasked instance that truly overlaps
+// [tMin, tMax] (triangles: the exact hit at tMin <= t <= tMax; AABBs: the box touches
+// the interval, inclusive). Throws refray::Error if Embree reported an error.
+void gatherCandidates(const GatherRequest& request);
+
+}  // namespace refray::dxr::detail

@@ -1,0 +1,198 @@
+// The ray-tracing state object: shader exports as C++ callables, hit groups, root-signature
+// associations, shader and pipeline config, and shader identifiers (PIPE, ASSOC, REC-8..10).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <typeinfo>
+#include <type_traits>
+#include <vector>
+
+#include "emulator/root_signature.h"
+#include "emulator/types.h"
+
+namespace refray::dxr {
+
+class ShaderContext;
+
+// Identifies a payload / attribute / parameter struct: same id <=> same C++ type.
+struct TypeTag {
+    const void* id = nullptr;
+    uint32_t size = 0;
+    const char* mangledName = "";
+    bool operator==(const TypeTag& o) const { return id == o.id; }
+    bool valid() const { return id != nullptr; }
+    std::string name() const;  // demangled
+};
+
+template <class T>
+TypeTag typeTag() {
+    static_assert(std::is_trivially_copyable_v<T>, "payloads, attributes and parameters are plain HLSL-like structs");
+    static const char anchor = 0;
+    return TypeTag{&anchor, uint32_t(sizeof(T)), typeid(T).name()};
+}
+
+// What the emulator calls: payload/attributes are type-erased pointers whose types
+// were checked against the export's declared TypeTags before the call.
+using ErasedShader = std::function<void(ShaderContext&, void* payload, const void* attributes)>;
+
+struct ShaderExport {
+    std::string name;
+    ShaderStage stage = ShaderStage::RayGeneration;
+    TypeTag payload;     // AHS, CHS, miss
+    TypeTag attributes;  // IS (what it reports), AHS, CHS
+    TypeTag parameters;  // callable
+    ErasedShader function;
+};
+
+// A DXIL library: named shader exports. Signatures mirror HLSL entry points:
+//   [shader("closesthit")] void CH(inout Payload p, in Attributes a)
+//     -> addClosestHit<Payload, Attributes>("CH", [](ShaderContext& ctx, Payload& p, const Attributes& a) {...})
+class ShaderLibrary {
+public:
+    void addRayGeneration(std::string name, std::function<void(ShaderContext&)> fn);
+    template <class Attributes>
+    void addIntersection(std::string name, std::function<void(ShaderContext&)> fn) {
+        add({std::move(name), ShaderStage::Intersection, {}, typeTag<Attributes>(), {},
+             [fn = std::move(fn)](ShaderContext& c, void*, const void*) { fn(c); }});
+    }
+    template <class Payload, class Attributes>
+    void addAnyHit(std::string name, std::function<void(ShaderContext&, Payload&, const Attributes&)> fn) {
+        add({std::move(name), ShaderStage::AnyHit, typeTag<Payload>(), typeTag<Attributes>(), {},
+             [fn = std::move(fn)](ShaderContext& c, void* p, const void* a) {
+                 fn(c, *static_cast<Payload*>(p), *static_cast<const Attributes*>(a));
+             }});
+    }
+    template <class Payload, class Attributes>
+    void addClosestHit(std::string name, std::function<void(ShaderContext&, Payload&, const Attributes&)> fn) {
+        add({std::move(name), ShaderStage::ClosestHit, typeTag<Payload>(), typeTag<Attributes>(), {},
+             [fn = std::move(fn)](ShaderContext& c, void* p, const void* a) {
+                 fn(c, *static_cast<Payload*>(p), *static_cast<const Attributes*>(a));
+             }});
+    }
+    template <class Payload>
+    void addMiss(std::string name, std::function<void(ShaderContext&, Payload&)> fn) {
+        add({std::move(name), ShaderStage::Miss, typeTag<Payload>(), {}, {},
+             [fn = std::move(fn)](ShaderContext& c, void* p, const void*) { fn(c, *static_cast<Payload*>(p)); }});
+    }
+    template <class Parameters>
+    void addCallable(std::string name, std::function<void(ShaderContext&, Parameters&)> fn) {
+        add({std::move(name), ShaderStage::Callable, {}, {}, typeTag<Parameters>(),
+             [fn = std::move(fn)](ShaderContext& c, void* p, const void*) { fn(c, *static_cast<Parameters*>(p)); }});
+    }
+
+    const std::map<std::string, ShaderExport>& exports() const { return exports_; }
+    const ShaderExport* find(const std::string& name) const;
+
+private:
+    void add(ShaderExport e);
+    std::map<std::string, ShaderExport> exports_;
+};
+
+enum class HitGroupType : uint8_t { Triangles = 0, ProceduralPrimitive = 1 };
+
+// D3D12_HIT_GROUP_DESC (PIPE-4); an empty import leaves the slot empty.
+struct HitGroupDesc {
+    std::string HitGroupExport;
+    HitGroupType Type = HitGroupType::Triangles;
+    std::string AnyHitShaderImport;
+    std::string ClosestHitShaderImport;
+    std::string IntersectionShaderImport;
+};
+
+// A root-signature subobject and its association. An empty export list makes it a
+// default association (ASSOC-2); otherwise it is explicit for exactly those exports.
+struct RootSignatureAssociation {
+    RootSignaturePtr signature;
+    std::vector<std::string> exports;
+};
+
+struct ShaderConfig {  // D3D12_RAYTRACING_SHADER_CONFIG (PIPE-1)
+    uint32_t MaxPayloadSizeInBytes = 0;
+    uint32_t MaxAttributeSizeInBytes = 0;
+};
+
+struct PipelineConfig {  // D3D12_RAYTRACING_PIPELINE_CONFIG1 (PIPE-2, PIPE-3)
+    uint32_t MaxTraceRecursionDepth = 1;
+    uint32_t Flags = PIPELINE_FLAG_NONE;
+};
+
+struct DxilLibraryDesc {
+    std::shared_ptr<const ShaderLibrary> library;
+    std::vector<std::string> exports;  // empty: every export of the library
+};
+
+// D3D12_STATE_OBJECT_DESC of type RAYTRACING_PIPELINE, as lists of subobjects.
+struct StateObjectDesc {
+    std::string name = "pipeline";
+    std::vector<DxilLibraryDesc> libraries;
+    std::vector<HitGroupDesc> hitGroups;
+    std::vector<RootSignatureAssociation> localRootSignatures;
+    std::vector<RootSignatureAssociation> globalRootSignatures;
+    std::vector<ShaderConfig> shaderConfigs;      // required; every copy must match
+    std::vector<PipelineConfig> pipelineConfigs;  // required; every copy must match
+};
+
+using ShaderIdentifier = std::array<uint8_t, 32>;
+
+// What a shader identifier names: a ray generation, miss or callable shader, or a hit group.
+struct ProgramEntry {
+    enum class Kind : uint8_t { RayGeneration, Miss, Callable, HitGroup };
+    Kind kind = Kind::RayGeneration;
+    std::string name;
+    uint32_t index = 0;
+    ShaderIdentifier identifier{};
+    const ShaderExport* shader = nullptr;  // non-hit-group entries
+    HitGroupType hitGroupType = HitGroupType::Triangles;
+    const ShaderExport* intersection = nullptr;
+    const ShaderExport* anyHit = nullptr;
+    const ShaderExport* closestHit = nullptr;
+    TypeTag payload;     // hit groups: the payload their AHS/CHS take (may be empty)
+    TypeTag attributes;  // hit groups: the attribute struct of their hits
+    RootSignaturePtr localRootSignature;   // may be null: no local arguments
+    RootSignaturePtr globalRootSignature;  // may be null
+};
+std::string_view toString(ProgramEntry::Kind kind);
+
+class StateObject {
+public:
+    // Validates and resolves associations. Throws DxrError naming the export and rule.
+    static std::shared_ptr<const StateObject> create(const StateObjectDesc& desc);
+
+    const std::string& name() const { return name_; }
+    uint32_t familyId() const { return familyId_; }
+    uint32_t maxTraceRecursionDepth() const { return pipelineConfig_.MaxTraceRecursionDepth; }
+    uint32_t pipelineFlags() const { return pipelineConfig_.Flags; }
+    const ShaderConfig& shaderConfig() const { return shaderConfig_; }
+    const std::vector<ProgramEntry>& entries() const { return entries_; }
+
+    // ID3D12StateObjectProperties::GetShaderIdentifier: nullptr for an unknown name or
+    // for an IS/AHS/CHS export, which have no identifier (REC-9).
+    const uint8_t* GetShaderIdentifier(const std::string& exportName) const;
+    // The same, but throws refray::Error with a "did you mean" for an unknown name.
+    ShaderIdentifier shaderIdentifier(const std::string& exportName) const;
+    const ProgramEntry* findEntry(const std::string& exportName) const;
+
+    // Decodes 32 identifier bytes: the entry, or nullptr when they are not an identifier
+    // of this state object (the caller reports REC-8/REC-9). isNull is set for all zeros.
+    const ProgramEntry* resolve(const uint8_t* identifier, bool& isNull) const;
+    // For diagnostics: what another state object's identifier names ("'X' of state object 'Y'").
+    static std::string describeForeignIdentifier(const uint8_t* identifier);
+
+private:
+    std::string name_;
+    uint32_t familyId_ = 0;
+    ShaderConfig shaderConfig_;
+    PipelineConfig pipelineConfig_;
+    std::vector<ProgramEntry> entries_;
+    std::map<std::string, uint32_t> byName_;
+    std::vector<std::shared_ptr<const ShaderLibrary>> libraries_;  // keeps exports alive
+};
+
+using StateObjectPtr = std::shared_ptr<const StateObject>;
+
+}  // namespace refray::dxr

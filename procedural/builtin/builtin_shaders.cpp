@@ -1,0 +1,120 @@
+#include "procedural/builtin/builtin_shaders.h"
+
+#include <cmath>
+
+#include "emulator/shader_api.h"
+
+namespace refray::procedural::builtin {
+
+using namespace refray::dxr;
+
+namespace {
+
+constexpr float kTMax = 10000.0f;
+constexpr vec4 kSkyTop{0.35f, 0.55f, 0.9f, 1.0f};
+constexpr vec4 kSkyHorizon{0.85f, 0.9f, 1.0f, 1.0f};
+
+SceneConstants sceneConstants(ShaderContext& ctx) {
+    return ctx.load<SceneConstants>(ctx.globalRootDescriptor(kSceneConstants));
+}
+
+vec3 hitWorldPosition(ShaderContext& ctx) { return ctx.WorldRayOrigin() + ctx.RayTCurrent() * ctx.WorldRayDirection(); }
+
+vec4 traceRadiance(ShaderContext& ctx, vec3 origin, vec3 direction, uint32_t depth) {
+    if (depth >= kMaxRecursionDepth) return vec4(0.0f);
+    RadiancePayload payload{vec4(0.0f), depth + 1};
+    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_CULL_BACK_FACING_TRIANGLES, 0xFF, 0,
+                 kRayTypeCount, 0, RayDesc{origin, 0.001f, direction, kTMax}, payload);
+    return payload.color;
+}
+
+bool inShadow(ShaderContext& ctx, vec3 origin, vec3 toLight, float distance, uint32_t depth) {
+    if (depth >= kMaxRecursionDepth) return false;
+    ShadowPayload payload{1};
+    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure),
+                 RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_SKIP_CLOSEST_HIT_SHADER, 0xFF,
+                 1, kRayTypeCount, 1, RayDesc{origin, 0.001f, toLight, distance}, payload);
+    return payload.hit != 0;
+}
+
+vec3 shade(ShaderContext& ctx, vec3 albedo, vec3 normal, vec3 position, uint32_t depth) {
+    const SceneConstants sc = sceneConstants(ctx);
+    const vec3 toLight = vec3(sc.lightPosition) - position;
+    const float distance = glm::length(toLight);
+    const vec3 l = toLight / distance;
+    const float lambert = std::max(0.0f, glm::dot(normal, l));
+    const bool shadowed = lambert > 0.0f && inShadow(ctx, position, l, distance, depth);
+    return albedo * (0.15f + (shadowed ? 0.0f : 0.85f * lambert));
+}
+
+}  // namespace
+
+std::shared_ptr<ShaderLibrary> makeShaderLibrary() {
+    auto lib = std::make_shared<ShaderLibrary>();
+
+    lib->addRayGeneration("RayGen", [](ShaderContext& ctx) {
+        const uvec3 index = ctx.DispatchRaysIndex();
+        const uvec3 dims = ctx.DispatchRaysDimensions();
+        const SceneConstants sc = sceneConstants(ctx);
+        const float sx = (float(index.x) + 0.5f) / float(dims.x) * 2.0f - 1.0f;
+        const float sy = -((float(index.y) + 0.5f) / float(dims.y) * 2.0f - 1.0f);
+        const vec3 d = glm::normalize(vec3(sc.cameraForward) + sx * vec3(sc.cameraRight) + sy * vec3(sc.cameraUp));
+        const vec4 color = traceRadiance(ctx, vec3(sc.cameraPosition), d, 0);
+        ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputTable)).at(index.x, index.y) = color;
+    });
+
+    lib->addMiss<RadiancePayload>("Miss", [](ShaderContext& ctx, RadiancePayload& payload) {
+        const float up = std::clamp(glm::normalize(ctx.WorldRayDirection()).y, 0.0f, 1.0f);
+        payload.color = kSkyHorizon + (kSkyTop - kSkyHorizon) * up;
+    });
+
+    lib->addMiss<ShadowPayload>("Miss_Shadow", [](ShaderContext&, ShadowPayload& payload) { payload.hit = 0; });
+
+    lib->addClosestHit<RadiancePayload, BuiltInTriangleIntersectionAttributes>(
+        "ClosestHit_Plane", [](ShaderContext& ctx, RadiancePayload& payload, const BuiltInTriangleIntersectionAttributes&) {
+            const MaterialConstants m = ctx.localRootConstants<MaterialConstants>(kMaterialParameter);
+            const vec3 p = hitWorldPosition(ctx);
+            const bool checker = (int(std::floor(p.x)) + int(std::floor(p.z))) & 1;
+            const vec3 albedo = vec3(m.albedo) * (checker ? 1.0f : 0.55f);
+            payload.color = vec4(shade(ctx, albedo, vec3(0.0f, 1.0f, 0.0f), p, payload.recursionDepth), 1.0f);
+        });
+
+    // Analytic sphere in object space; reports t in the caller's (object = world) units.
+    lib->addIntersection<SphereAttributes>("Intersection_Sphere", [](ShaderContext& ctx) {
+        const SceneConstants sc = sceneConstants(ctx);
+        const vec3 centre = vec3(sc.sphere);
+        const float radius = sc.sphere.w;
+        const vec3 o = ctx.ObjectRayOrigin() - centre, d = ctx.ObjectRayDirection();
+        const float a = glm::dot(d, d), b = glm::dot(o, d), c = glm::dot(o, o) - radius * radius;
+        const float disc = b * b - a * c;
+        if (disc < 0.0f) return;
+        const float root = std::sqrt(disc);
+        for (float t : {(-b - root) / a, (-b + root) / a}) {
+            if (t >= ctx.RayTMin() && t <= ctx.RayTCurrent()) {
+                ctx.ReportHit(t, 0, SphereAttributes{(o + t * d) / radius});
+                return;
+            }
+        }
+    });
+
+    lib->addClosestHit<RadiancePayload, SphereAttributes>(
+        "ClosestHit_Sphere", [](ShaderContext& ctx, RadiancePayload& payload, const SphereAttributes& attr) {
+            const MaterialConstants m = ctx.localRootConstants<MaterialConstants>(kMaterialParameter);
+            // Object-space normal to world: the inverse transpose of ObjectToWorld.
+            const Matrix3x4 w2o = ctx.WorldToObject3x4();
+            const vec3 n = glm::normalize(vec3(w2o.m[0][0] * attr.normal.x + w2o.m[1][0] * attr.normal.y + w2o.m[2][0] * attr.normal.z,
+                                               w2o.m[0][1] * attr.normal.x + w2o.m[1][1] * attr.normal.y + w2o.m[2][1] * attr.normal.z,
+                                               w2o.m[0][2] * attr.normal.x + w2o.m[1][2] * attr.normal.y + w2o.m[2][2] * attr.normal.z));
+            const vec3 p = hitWorldPosition(ctx);
+            vec3 color = shade(ctx, vec3(m.albedo), n, p, payload.recursionDepth);
+            const float reflectance = m.albedo.w;
+            if (reflectance > 0.0f) {
+                const vec3 r = glm::reflect(ctx.WorldRayDirection(), n);
+                color += reflectance * vec3(traceRadiance(ctx, p, r, payload.recursionDepth));
+            }
+            payload.color = vec4(color, 1.0f);
+        });
+    return lib;
+}
+
+}  // namespace refray::procedural::builtin

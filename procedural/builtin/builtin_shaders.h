@@ -1,0 +1,54 @@
+// Shaders of refray's small built-in scene: a triangle plane and an analytic sphere,
+// radiance and shadow ray types, 2 hit groups x 2 ray types. Written against the
+// shader API the way HLSL is written against DXR.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "core/math.h"
+#include "emulator/state_object.h"
+
+namespace refray::procedural::builtin {
+
+// Global root signature parameters.
+enum GlobalRootParameter : uint32_t {
+    kOutputTable = 0,    // descriptor table {UAV u0}: RWTexture2D<float4> g_output
+    kAccelerationStructure = 1,  // root SRV t0: the TLAS
+    kSceneConstants = 2,  // root CBV b0: SceneConstants
+};
+// Local root signature "Material": 4 root constants at b1 (MaterialConstants).
+inline constexpr uint32_t kMaterialParameter = 0;
+
+struct SceneConstants {
+    vec4 cameraPosition;
+    vec4 cameraRight;    // scaled by tan(fovY/2) * aspect
+    vec4 cameraUp;       // scaled by tan(fovY/2)
+    vec4 cameraForward;  // unit
+    vec4 lightPosition;
+    vec4 sphere;  // object-space centre (xyz) and radius (w)
+};
+
+struct MaterialConstants {
+    vec4 albedo;  // .w = reflectance
+};
+
+struct RadiancePayload {
+    vec4 color;
+    uint32_t recursionDepth;
+};
+
+struct ShadowPayload {
+    uint32_t hit;
+};
+
+struct SphereAttributes {
+    vec3 normal;  // object space
+};
+
+inline constexpr uint32_t kRayTypeCount = 2;  // radiance = 0, shadow = 1
+inline constexpr uint32_t kMaxRecursionDepth = 3;
+
+std::shared_ptr<dxr::ShaderLibrary> makeShaderLibrary();
+
+}  // namespace refray::procedural::builtin

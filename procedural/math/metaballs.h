@@ -1,0 +1,155 @@
+// Ports: D3D12 sample VolumetricPrimitives.hlsli (N_METABALLS = 3, static loops, no
+// active-ball limiting): quintic potential, central-difference normal, animated keyframes,
+// bounding-sphere span and the fixed 128-sample march.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
+
+#include "procedural/math/analytic.h"
+#include "procedural/math/hlsl.h"
+#include "procedural/math/ray.h"
+
+namespace refray::procedural::math {
+
+template <typename T>
+struct Metaball {
+    vec3<T> center;
+    T radius;
+};
+
+inline constexpr int N_METABALLS = 3;
+
+template <typename T>
+using Metaballs = std::array<Metaball<T>, N_METABALLS>;
+
+// Potential of one ball: with d = radius - |position - center| (inside the radius),
+// 6 d^5/r^5 - 15 d^4/r^4 + 10 d^3/r^3: 1 at the centre, 0 at the radius; 0 outside.
+template <typename T>
+T CalculateMetaballPotential(const vec3<T>& position, const Metaball<T>& blob, T& distance) {
+    distance = hlsl::length(position - blob.center);
+    if (distance <= blob.radius) {
+        T d = distance;
+        d = blob.radius - d;
+        const T r = blob.radius;
+        return T(6) * (d * d * d * d * d) / (r * r * r * r * r) - T(15) * (d * d * d * d) / (r * r * r * r) +
+               T(10) * (d * d * d) / (r * r * r);
+    }
+    return T(0);
+}
+
+template <typename T>
+T CalculateMetaballsPotential(const vec3<T>& position, const Metaballs<T>& blobs) {
+    T sumFieldPotential = T(0);
+    for (int j = 0; j < N_METABALLS; j++) {
+        T dummy;
+        sumFieldPotential += CalculateMetaballPotential(position, blobs[j], dummy);
+    }
+    return sumFieldPotential;
+}
+
+// Minus the central-difference gradient, normalised (points outward); e = 0.5773e-5.
+// A zero gradient gives a NaN normal (D3D12 H11).
+template <typename T>
+vec3<T> CalculateMetaballsNormal(const vec3<T>& position, const Metaballs<T>& blobs) {
+    // `0.5773 * 0.00001` is a literal-only product: folded at full precision, then rounded.
+    const T e = static_cast<T>(0.5773 * 0.00001);
+    return hlsl::normalize(vec3<T>(CalculateMetaballsPotential(position + vec3<T>(-e, 0, 0), blobs) -
+                                       CalculateMetaballsPotential(position + vec3<T>(e, 0, 0), blobs),
+                                   CalculateMetaballsPotential(position + vec3<T>(0, -e, 0), blobs) -
+                                       CalculateMetaballsPotential(position + vec3<T>(0, e, 0), blobs),
+                                   CalculateMetaballsPotential(position + vec3<T>(0, 0, -e), blobs) -
+                                       CalculateMetaballsPotential(position + vec3<T>(0, 0, e), blobs)));
+}
+
+// Centres lerp between two keyframes by CalculateAnimationInterpolant(elapsedTime, cycleDuration).
+template <typename T>
+Metaballs<T> InitializeAnimatedMetaballs(T elapsedTime, T cycleDuration) {
+    const vec3<T> keyFrameCenters[N_METABALLS][2] = {
+        {vec3<T>(T(-0.3), T(-0.3), T(-0.4)), vec3<T>(T(0.3), T(-0.3), T(-0.0))},
+        {vec3<T>(T(0.0), T(-0.2), T(0.5)), vec3<T>(T(0.0), T(0.4), T(0.5))},
+        {vec3<T>(T(0.4), T(0.4), T(0.4)), vec3<T>(T(-0.4), T(0.2), T(-0.4))},
+    };
+    const T radii[N_METABALLS] = {T(0.45), T(0.55), T(0.45)};
+
+    const T tAnimate = CalculateAnimationInterpolant(elapsedTime, cycleDuration);
+    Metaballs<T> blobs{};
+    for (int j = 0; j < N_METABALLS; j++) {
+        blobs[j].center = hlsl::lerp(keyFrameCenters[j][0], keyFrameCenters[j][1], tAnimate);
+        blobs[j].radius = radii[j];
+    }
+    return blobs;
+}
+
+// Union of the balls' solid-sphere spans (roots in front or behind), clipped to [TMin, TCurrent].
+// A ray missing every ball leaves tmin = +inf, tmax = -inf before the clip (D3D12 H8).
+template <typename T>
+void FindIntersectingMetaballs(const Ray<T>& ray, const RayExtent<T>& extent, T& tmin, T& tmax,
+                               const Metaballs<T>& blobs) {
+    tmin = std::numeric_limits<T>::infinity();
+    tmax = -std::numeric_limits<T>::infinity();
+    for (int i = 0; i < N_METABALLS; i++) {
+        T _thit = T(0);
+        T _tmax = T(0);
+        if (RaySolidSphereIntersectionTest(ray, extent, _thit, _tmax, blobs[i].center, blobs[i].radius)) {
+            tmin = hlsl::min(_thit, tmin);
+            tmax = hlsl::max(_tmax, tmax);
+        }
+    }
+    tmin = hlsl::max(tmin, extent.tMin);
+    tmax = hlsl::min(tmax, extent.tCurrent);
+}
+
+template <typename T>
+struct MetaballsHit {
+    bool hit = false;
+    T thit = T(0);
+    vec3<T> normal{};
+    std::uint32_t step = 0;  // 1-based index of the sample that hit
+};
+
+// 128 samples t = tmin + k*(tmax - tmin)/128; the first sample with potential >= 0.25 whose
+// normal passes IsAValidHit is the hit (no refinement: up to one step inside the surface).
+// The step depends on TCurrent at call time (D3D12 H10); with no ball hit the samples are
+// inf/NaN and nothing is reported (H8).
+template <typename T>
+MetaballsHit<T> RayMetaballsIntersectionTest(const Ray<T>& ray, const RayExtent<T>& extent, T elapsedTime,
+                                             T cycleDuration = T(12)) {
+    MetaballsHit<T> result;
+    const Metaballs<T> blobs = InitializeAnimatedMetaballs(elapsedTime, cycleDuration);
+
+    T tmin = T(0);
+    T tmax = T(0);
+    FindIntersectingMetaballs(ray, extent, tmin, tmax, blobs);
+
+    const std::uint32_t MAX_STEPS = 128;
+    T t = tmin;
+    const T minTStep = (tmax - tmin) / static_cast<T>(MAX_STEPS / 1);
+    std::uint32_t iStep = 0;
+
+    while (iStep++ < MAX_STEPS) {
+        const vec3<T> position = ray.origin + t * ray.direction;
+        T sumFieldPotential = T(0);
+        for (int j = 0; j < N_METABALLS; j++) {
+            T distance;
+            sumFieldPotential += CalculateMetaballPotential(position, blobs[j], distance);
+        }
+
+        const T Threshold = T(0.25);
+        if (sumFieldPotential >= Threshold) {
+            const vec3<T> normal = CalculateMetaballsNormal(position, blobs);
+            if (IsAValidHit(ray, t, normal, extent)) {
+                result.hit = true;
+                result.thit = t;
+                result.normal = normal;
+                result.step = iStep;
+                return result;
+            }
+        }
+        t += minTStep;
+    }
+    return result;
+}
+
+}  // namespace refray::procedural::math

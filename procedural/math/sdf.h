@@ -1,0 +1,283 @@
+// Ports: SignedDistancePrimitives.hlsli (both samples); SDF cases of D3D12 ProceduralPrimitivesLibrary.hlsli.
+// Operators, primitives, sdCalculateNormal and RaySignedDistancePrimitiveTest, templated on T;
+// the fractal pyramid and the D3D12 switch live in fractals.h.
+#pragma once
+
+#include <cstdint>
+
+#include "procedural/math/hlsl.h"
+#include "procedural/math/ray.h"
+
+namespace refray::procedural::math {
+
+// ---- Operators -------------------------------------------------------------------------------
+// Subtract: Obj1 - Obj2 = max(d1, -d2).
+template <typename T>
+T opS(T d1, T d2) { return hlsl::max(d1, -d2); }
+// Union = min(d1, d2).
+template <typename T>
+T opU(T d1, T d2) { return hlsl::min(d1, d2); }
+// Intersection = max(d1, d2).
+template <typename T>
+T opI(T d1, T d2) { return hlsl::max(d1, d2); }
+
+// Repetition with the HLSL fmod intrinsic: no repetition for negative p (sign of the dividend,
+// D3D12 H14), and DXC's frac-based remainder at cell boundaries.
+template <typename T>
+vec3<T> opRep(const vec3<T>& p, const vec3<T>& c) { return hlsl::fmod(p, c) - T(0.5) * c; }
+
+// Polynomial smooth min (union) and smooth max (intersection).
+template <typename T>
+T smin(T a, T b, T k) {
+    const T h = hlsl::clamp(T(0.5) + T(0.5) * (b - a) / k, T(0), T(1));
+    return hlsl::lerp(b, a, h) - k * h * (T(1) - h);
+}
+template <typename T>
+T smax(T a, T b, T k) {
+    const T h = hlsl::clamp(T(0.5) + T(0.5) * (b - a) / k, T(0), T(1));
+    return hlsl::lerp(a, b, h) + k * h * (T(1) - h);
+}
+template <typename T>
+T opBlendU(T d1, T d2) { return smin(d1, d2, T(0.1)); }
+template <typename T>
+T opBlendI(T d1, T d2) { return smax(d1, d2, T(0.1)); }
+
+// Twist about y: (c*x - s*z, s*x + c*z, y) with c = cos 3y, s = sin 3y. Note the component
+// order: the rotated xz pair goes to .xy and the old y to .z, as the HLSL writes it.
+template <typename T>
+vec3<T> opTwist(const vec3<T>& p) {
+    const T c = hlsl::cos(T(3) * p.y);
+    const T s = hlsl::sin(T(3) * p.y);
+    // float2x2 m = (c, -s, s, c); mul(m, p.xz)
+    return vec3<T>(c * p.x - s * p.z, s * p.x + c * p.z, p.y);
+}
+
+// ---- Primitives ------------------------------------------------------------------------------
+template <typename T>
+T sdPlane(const vec3<T>& p) { return p.y; }
+
+template <typename T>
+T sdSphere(const vec3<T>& p, T s) { return hlsl::length(p) - s; }
+
+// Box extents <-b, b>.
+template <typename T>
+T sdBox(const vec3<T>& p, const vec3<T>& b) {
+    const vec3<T> d = hlsl::abs(p) - b;
+    return hlsl::min(hlsl::max(d.x, hlsl::max(d.y, d.z)), T(0)) + hlsl::length(hlsl::max(d, T(0)));
+}
+
+template <typename T>
+T sdEllipsoid(const vec3<T>& p, const vec3<T>& r) {
+    return (hlsl::length(p / r) - T(1)) * hlsl::min(hlsl::min(r.x, r.y), r.z);
+}
+
+// Unsigned rounded box: inner half-size b, rounding radius r.
+template <typename T>
+T udRoundBox(const vec3<T>& p, const vec3<T>& b, T r) {
+    return hlsl::length(hlsl::max(hlsl::abs(p) - b, T(0))) - r;
+}
+
+// t = {ring radius, tube radius}; ring in the xz plane.
+template <typename T>
+T sdTorus(const vec3<T>& p, const vec2<T>& t) {
+    const vec2<T> q(hlsl::length(vec2<T>(p.x, p.z)) - t.x, p.y);
+    return hlsl::length(q) - t.y;
+}
+
+template <typename T>
+T sdHexPrism(const vec3<T>& p, const vec2<T>& h) {
+    const vec3<T> q = hlsl::abs(p);
+    const T d1 = q.z - h.y;
+    const T d2 = hlsl::max(q.x * T(0.866025) + q.y * T(0.5), q.y) - h.x;
+    return hlsl::length(hlsl::max(vec2<T>(d1, d2), T(0))) + hlsl::min(hlsl::max(d1, d2), T(0));
+}
+
+// Capsule from a to b with radius r.
+template <typename T>
+T sdCapsule(const vec3<T>& p, const vec3<T>& a, const vec3<T>& b, T r) {
+    const vec3<T> pa = p - a;
+    const vec3<T> ba = b - a;
+    const T h = hlsl::clamp(hlsl::dot(pa, ba) / hlsl::dot(ba, ba), T(0), T(1));
+    return hlsl::length(pa - ba * h) - r;
+}
+
+// Triangular prism along z (the "distance bound" branch, #if 1 in the HLSL):
+// h.x = triangle size, h.y = half length. Note p.y (not |p.y|) in d2.
+template <typename T>
+T sdTriPrism(const vec3<T>& p, const vec2<T>& h) {
+    const vec3<T> q = hlsl::abs(p);
+    const T d1 = q.z - h.y;
+    const T d2 = hlsl::max(q.x * T(0.866025) + p.y * T(0.5), -p.y) - h.x * T(0.5);
+    return hlsl::length(hlsl::max(vec2<T>(d1, d2), T(0))) + hlsl::min(hlsl::max(d1, d2), T(0));
+}
+
+// Capped cylinder about y: h = {radius, half height}.
+template <typename T>
+T sdCylinder(const vec3<T>& p, const vec2<T>& h) {
+    const vec2<T> d = hlsl::abs(vec2<T>(hlsl::length(vec2<T>(p.x, p.z)), p.y)) - h;
+    return hlsl::min(hlsl::max(d.x, d.y), T(0)) + hlsl::length(hlsl::max(d, T(0)));
+}
+
+// h = {sin a, cos a, height}; octahedron centred at the origin (the ground plane cuts it).
+template <typename T>
+T sdOctahedron(const vec3<T>& p, const vec3<T>& h) {
+    const T d = hlsl::dot(vec2<T>(hlsl::max(hlsl::abs(p.x), hlsl::abs(p.z)), hlsl::abs(p.y)), vec2<T>(h.x, h.y));
+    return d - h.y * h.z;
+}
+
+// Pyramid sitting on y = 0: the octahedron minus its lower half.
+template <typename T>
+T sdPyramid(const vec3<T>& p, const vec3<T>& h) {
+    const T octa = sdOctahedron(p, h);
+    return opS(octa, p.y);
+}
+
+// (x^6 + y^6)^(1/6) through pow (exp2/log2).
+template <typename T>
+T length_toPowNegative6(vec2<T> p) {
+    p = p * p * p;
+    p = p * p;
+    return hlsl::pow(p.x + p.y, T(1.0) / T(6.0));
+}
+
+// The L8 norm (x^8 + y^8)^(1/8), despite the HLSL name.
+template <typename T>
+T length_toPowNegative8(vec2<T> p) {
+    p = p * p;
+    p = p * p;
+    p = p * p;
+    return hlsl::pow(p.x + p.y, T(1.0) / T(8.0));
+}
+
+// Torus with an L8 ("square") tube cross-section.
+template <typename T>
+T sdTorus82(const vec3<T>& p, const vec2<T>& t) {
+    const vec2<T> q(hlsl::length(vec2<T>(p.x, p.z)) - t.x, p.y);
+    return length_toPowNegative8(q) - t.y;
+}
+
+template <typename T>
+T sdTorus88(const vec3<T>& p, const vec2<T>& t) {
+    const vec2<T> q(length_toPowNegative8(vec2<T>(p.x, p.z)) - t.x, p.y);
+    return length_toPowNegative8(q) - t.y;
+}
+
+template <typename T>
+T sdCylinder6(const vec3<T>& p, const vec2<T>& h) {
+    return hlsl::max(length_toPowNegative6(vec2<T>(p.x, p.z)) - h.x, hlsl::abs(p.y) - h.y);
+}
+
+// ---- D3D12 sample: the SDF cases of GetDistanceFromSignedDistancePrimitive -----------------
+// (local AABB space [-1,1]^3; FractalPyramid and the switch itself are in fractals.h)
+// PORT: each switch case is a named function so entry points and tests can call it directly.
+namespace d3d12 {
+
+// 4x4x4 spheres of radius 0.1625 in the unit box.
+template <typename T>
+T sdMiniSpheres(const vec3<T>& position) {
+    return opI(sdSphere(opRep(position + T(1), vec3<T>(T(2)) / T(4)), T(0.65) / T(4)),
+               sdBox(position, vec3<T>(T(1))));
+}
+
+// Round box (0.75, rounding 0.2) minus the ball of radius 1.2, intersected with the ball of 1.32.
+template <typename T>
+T sdIntersectedRoundCube(const vec3<T>& position) {
+    return opS(opS(udRoundBox(position, vec3<T>(T(0.75)), T(0.2)), sdSphere(position, T(1.20))),
+               -sdSphere(position, T(1.32)));
+}
+
+template <typename T>
+T sdSquareTorus(const vec3<T>& position) { return sdTorus82(position, vec2<T>(T(0.75), T(0.15))); }
+
+template <typename T>
+T sdTwistedTorus(const vec3<T>& position) { return sdTorus(opTwist(position), vec2<T>(T(0.6), T(0.2))); }
+
+// Square torus with 20 angular slots per turn; atan2 is DXC's (pi/2 on the axis, D3D12 H15).
+template <typename T>
+T sdCog(const vec3<T>& position) {
+    const vec3<T> q(hlsl::atan2(position.z, position.x) / T(6.2831), T(1),
+                    T(0.015) + T(0.25) * hlsl::length(position));
+    return opS(sdTorus82(position, vec2<T>(T(0.60), T(0.3))),
+               sdCylinder(opRep(q + T(1), vec3<T>(T(0.05), T(1), T(0.075))), vec2<T>(T(0.02), T(0.8))));
+}
+
+// Four columns of radius 0.3 at x, z = +-0.5, clipped to the box [-3, 1] in y.
+template <typename T>
+T sdCylinderColumns(const vec3<T>& position) {
+    return opI(sdCylinder(opRep(position + vec3<T>(T(1)), vec3<T>(T(1), T(2), T(1))), vec2<T>(T(0.3), T(2))),
+               sdBox(position + vec3<T>(T(1)), vec3<T>(T(2))));
+}
+
+}  // namespace d3d12
+
+// ---- Normal estimation -----------------------------------------------------------------------
+// The tetrahedral offset of sdCalculateNormal and Mandelbulb calcNormal: 0.5773 * 0.0001.
+template <typename T>
+T tetrahedralOffset() { return T(0.5773) * T(0.0001); }
+
+// normalize(k1*f(p+k1) + k2*f(p+k2) + k3*f(p+k3) + k4*f(p+k4)) with k = e*(+,-,-), e*(-,-,+),
+// e*(-,+,-), e*(+,+,+), summed in that order. A NaN or constant field gives a NaN normal.
+// PORT: takes the distance function as a callable (and the offset as a parameter) instead of
+// switching on SignedDistancePrimitive, so Mandelbulb's and Julia's calcNormal reuse it.
+template <typename T, class Sdf>
+vec3<T> sdCalculateNormal(const vec3<T>& pos, Sdf&& sdf, T offset = tetrahedralOffset<T>()) {
+    const vec2<T> e = vec2<T>(T(1), T(-1)) * offset;
+    const vec3<T> xyy(e.x, e.y, e.y);
+    const vec3<T> yyx(e.y, e.y, e.x);
+    const vec3<T> yxy(e.y, e.x, e.y);
+    const vec3<T> xxx(e.x, e.x, e.x);
+    return hlsl::normalize(xyy * T(sdf(pos + xyy)) + yyx * T(sdf(pos + yyx)) + yxy * T(sdf(pos + yxy)) +
+                           xxx * T(sdf(pos + xxx)));
+}
+
+// ---- Sphere tracing (RaySignedDistancePrimitiveTest) -------------------------------------------
+template <typename T>
+struct SphereTraceParams {
+    T threshold = T(0.0001);  // hit when distance <= threshold * t
+    std::uint32_t maxSteps = 512;
+    T stepScale = T(1);
+    T normalOffset = tetrahedralOffset<T>();
+};
+
+template <typename T>
+struct SphereTraceResult {
+    bool hit = false;
+    T thit = T(0);
+    vec3<T> normal{};    // local-space normal at the hit
+    vec3<T> position{};  // the sample that produced the hit
+    std::uint32_t steps = 0;  // loop iterations taken
+};
+
+// PORT: RayTMin()/RayTCurrent()/RayFlags() come in as `extent` (RayTCurrent cannot change inside
+// the loop, which never calls ReportHit); the HLSL `out` thit/attr become the result struct.
+// t starts at extent.tMin; at most maxSteps iterations while t <= extent.tCurrent:
+// dist = sdf(o + t*d); if dist <= threshold*t, the normal is estimated and the hit is returned
+// if IsAValidHit accepts it; otherwise (also for a rejected candidate) t += stepScale*dist.
+// Negative distances step t backwards, as in the HLSL.
+template <typename T, class Sdf>
+SphereTraceResult<T> RaySignedDistancePrimitiveTest(const Ray<T>& ray, const RayExtent<T>& extent, Sdf&& sdf,
+                                                    const SphereTraceParams<T>& params = {}) {
+    SphereTraceResult<T> result;
+    T t = extent.tMin;
+    std::uint32_t i = 0;
+    while (i++ < params.maxSteps && t <= extent.tCurrent) {
+        result.steps = i;
+        const vec3<T> position = ray.origin + t * ray.direction;
+        const T distance = sdf(position);
+
+        if (distance <= params.threshold * t) {
+            const vec3<T> hitSurfaceNormal = sdCalculateNormal(position, sdf, params.normalOffset);
+            if (IsAValidHit(ray, t, hitSurfaceNormal, extent)) {
+                result.hit = true;
+                result.thit = t;
+                result.normal = hitSurfaceNormal;
+                result.position = position;
+                return result;
+            }
+        }
+        t += params.stepScale * distance;
+    }
+    return result;
+}
+
+}  // namespace refray::procedural::math
