@@ -49,6 +49,8 @@ struct ThreadState {
     std::vector<Candidate> candidates;
     uint64_t rayCounter = 0;
     std::vector<Diagnostic> stopErrors;  // OnError::Stop: the errors that ended a launch
+    GpuVirtualAddress lastTlasAddress = 0;  // one-entry cache of the TLAS lookup
+    const TopLevelAS* lastTlas = nullptr;
 };
 
 // Non-local exits (IS-10, AHS-4). They never carry errors and never leave the dispatcher.
@@ -84,7 +86,7 @@ void raise(ThreadState& ts, const Site& site, const Diagnostic& d) {
 
 void warn(ThreadState& ts, const Site& site, const Diagnostic& d) { ts.log.add(locate(ts, d, site), ts.linearIndex); }
 
-std::string tableName(ProgramEntry::Kind kind) {
+const char* tableName(ProgramEntry::Kind kind) {
     switch (kind) {
         case ProgramEntry::Kind::HitGroup: return "hit-group table";
         case ProgramEntry::Kind::Miss: return "miss shader table";
@@ -120,21 +122,21 @@ bool lookupRecord(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
                   const GpuVirtualAddressRangeAndStride& table, uint64_t index, RecordView& out,
                   const HitLookupContext* hit = nullptr) {
     const DispatchState& ds = *ts.dispatch;
-    const std::string name = tableName(kind);
+    const std::string_view name = tableName(kind);
     out = RecordView{};
     out.index = index;
     const uint64_t offset = table.StrideInBytes * index;
     out.address = table.StartAddress + offset;
 
     if (table.StartAddress == 0 && table.SizeInBytes == 0) {
-        auto b = diag("IDX-11", "the " + name + " is missing (StartAddress 0, SizeInBytes 0) but a record is needed");
+        auto b = diag("IDX-11", "the " + std::string(name) + " is missing (StartAddress 0, SizeInBytes 0) but a record is needed");
         b.value("index", index);
         addHitValues(b, hit);
         raise(ts, site, b);
         return false;
     }
     if (offset + kShaderIdentifierSizeInBytes > table.SizeInBytes) {
-        auto b = diag("IDX-11", "record index past the end of the " + name);
+        auto b = diag("IDX-11", "record index past the end of the " + std::string(name));
         addHitValues(b, hit);
         b.value("index", index)
             .value("stride", table.StrideInBytes)
@@ -145,7 +147,8 @@ bool lookupRecord(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
     }
     const GpuBuffer* buffer = ds.memory->find(out.address, kShaderIdentifierSizeInBytes);
     const uint8_t* bytes = buffer ? buffer->bytes.data() + (out.address - buffer->base) : nullptr;
-    if (!bytes || !ds.memory->isWritten(out.address, kShaderIdentifierSizeInBytes)) {
+    const uint8_t* identifierWritten = buffer ? buffer->written.data() + (out.address - buffer->base) : nullptr;
+    if (!bytes || std::memchr(identifierWritten, 0, kShaderIdentifierSizeInBytes)) {
         auto b = diag("IDX-11", "the record's shader identifier at this index was never written (uninitialized record)");
         addHitValues(b, hit);
         b.value("index", index).hex("address", out.address);
@@ -156,7 +159,7 @@ bool lookupRecord(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
     const ProgramEntry* entry = ds.pipeline->resolve(bytes, isNull);
     if (isNull) return true;  // REC-8: nothing runs for this purpose
     if (!entry) {
-        auto b = diag("REC-8", "the " + name + " record holds an identifier that is not an export of the bound state object '" +
+        auto b = diag("REC-8", "the " + std::string(name) + " record holds an identifier that is not an export of the bound state object '" +
                                    ds.pipeline->name() + "': it is " + StateObject::describeForeignIdentifier(bytes));
         addHitValues(b, hit);
         b.value("index", index).hex("address", out.address);
@@ -164,7 +167,7 @@ bool lookupRecord(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
         return false;
     }
     if (entry->kind != kind) {
-        auto b = diag("IDX-13", "the " + name + " record holds " + std::string(toString(entry->kind)) + " '" +
+        auto b = diag("IDX-13", "the " + std::string(name) + " record holds " + std::string(toString(entry->kind)) + " '" +
                                     entry->name + "', which does not belong in this table");
         addHitValues(b, hit);
         b.value("index", index);
@@ -184,7 +187,7 @@ bool lookupRecord(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
     }
     const uint32_t layout = entry->localRootSignature ? entry->localRootSignature->recordSize() : kShaderIdentifierSizeInBytes;
     if (table.StrideInBytes != 0 && table.StrideInBytes < layout) {
-        auto b = diag("IDX-10", "the " + name + " stride is smaller than the record of '" + entry->name + "'");
+        auto b = diag("IDX-10", "the " + std::string(name) + " stride is smaller than the record of '" + entry->name + "'");
         addHitValues(b, hit);
         b.value("stride", table.StrideInBytes).value("record bytes (REC-5)", layout, "<= stride");
         raise(ts, site, b);
@@ -193,7 +196,7 @@ bool lookupRecord(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
     const uint64_t available = table.StrideInBytes ? table.StrideInBytes : table.SizeInBytes - offset;
     if (available < layout || offset + layout > table.SizeInBytes) {
         auto b = diag(available < layout ? "REC-11" : "IDX-11",
-                      "the record of '" + entry->name + "' does not fit in the " + name);
+                      "the record of '" + entry->name + "' does not fit in the " + std::string(name));
         addHitValues(b, hit);
         b.value("record offset", offset)
             .value("record bytes (REC-5)", layout)
@@ -461,6 +464,9 @@ void orderCandidates(ThreadState& ts, RayState& rs) {
 }
 
 void validateRay(ThreadState& ts, const Site& site, const RayDesc& ray, bool& ok) {
+    const bool finite = allFinite(ray.Origin) && allFinite(ray.Direction) && std::isfinite(ray.TMin);
+    if (finite && !std::isnan(ray.TMax) && ray.TMin >= 0.0f && ray.TMin <= ray.TMax && ray.Direction != vec3(0.0f))
+        return;  // the common case: nothing to report
     auto field = [&](const char* name, float v) {
         if (std::isnan(v)) {
             raise(ts, site, diag("RAY-5", std::string("RayDesc.") + name + " is NaN").value(name, v));
@@ -575,7 +581,11 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
     ts.rayCounter++;
 
     if (asAddress != 0) {
-        rs.tlas = ds.device->findTopLevelAS(asAddress);
+        if (asAddress != ts.lastTlasAddress) {
+            ts.lastTlas = ds.device->findTopLevelAS(asAddress);
+            ts.lastTlasAddress = ts.lastTlas ? asAddress : 0;
+        }
+        rs.tlas = ts.lastTlas;
         if (!rs.tlas) {
             const bool isBottom = ds.device->findBottomLevelAS(asAddress) != nullptr;
             raise(ts, site, diag(isBottom ? "INST-10" : "RAY-1",
@@ -829,7 +839,7 @@ const uint8_t* ShaderContext::rootArgument(bool local, uint32_t parameter, size_
     if (offset + size > available)
         stageError(inv_, "REC-11", std::string(which) + " root parameter " + std::to_string(parameter) +
                                        " lies past the bytes available to the record");
-    if (!std::all_of(written + offset, written + offset + size, [](uint8_t w) { return w != 0; }))
+    if (std::memchr(written + offset, 0, size))
         stageError(inv_, "REC-7", std::string("shader reads ") + which + " root parameter " + std::to_string(parameter) +
                                       " of '" + signature->name() + "', whose bytes were never written");
     return bytes + offset;

@@ -9,12 +9,6 @@ namespace refray::scenes {
 using namespace refray::dxr;
 namespace builtin = refray::procedural::builtin;
 
-namespace {
-constexpr float kPlaneHalfSize = 6.0f;
-constexpr vec3 kSphereCentre{0.0f, 1.0f, 0.0f};
-constexpr float kSphereRadius = 1.0f;
-}  // namespace
-
 BuiltinScene::BuiltinScene() {
     GpuMemory& memory = device_.memory();
 
@@ -85,7 +79,7 @@ BuiltinScene::BuiltinScene() {
         args.setConstants(builtin::kMaterialParameter, builtin::MaterialConstants{albedo});
         return args;
     };
-    const vec4 planeAlbedo{0.9f, 0.85f, 0.75f, 0.0f}, sphereAlbedo{0.8f, 0.25f, 0.2f, 0.35f};
+    const vec4 planeAlbedo = kPlaneAlbedo, sphereAlbedo = kSphereAlbedo;
     const auto rayGen = ShaderTableBuilder("raygen").addRecord(pipeline_->shaderIdentifier("RayGen")).upload(memory);
     tables_.RayGenerationShaderRecord = {rayGen.StartAddress, rayGen.SizeInBytes};
     tables_.MissShaderTable = ShaderTableBuilder("miss")
@@ -100,22 +94,26 @@ BuiltinScene::BuiltinScene() {
                                 .upload(memory);
 }
 
-RenderResult BuiltinScene::render(const RenderSettings& settings) {
-    RenderResult result;
-    result.image = Image(settings.width, settings.height);
-    DescriptorHeap& heap = device_.createDescriptorHeap(1, "output heap");
-    heap.setTexture2D(0, DescriptorRangeType::UAV, &result.image);
-
+builtin::SceneConstants BuiltinScene::sceneConstants(uint32_t width, uint32_t height) {
     // Camera: eye up and to the side, looking at the sphere; 45 degree vertical field of view.
     const vec3 eye{4.5f, 3.0f, 6.0f}, target{0.0f, 0.8f, 0.0f};
     const vec3 forward = glm::normalize(target - eye);
     const vec3 right = glm::normalize(glm::cross(forward, vec3(0, 1, 0)));
     const vec3 up = glm::cross(right, forward);
     const float tanHalf = std::tan(0.5f * 0.7853982f);
-    const float aspect = float(settings.width) / float(settings.height);
-    const builtin::SceneConstants constants{vec4(eye, 1),          vec4(right * tanHalf * aspect, 0), vec4(up * tanHalf, 0),
-                                            vec4(forward, 0),      vec4(-3.0f, 7.0f, 4.0f, 1.0f),
-                                            vec4(0, 0, 0, kSphereRadius)};
+    const float aspect = float(width) / float(height);
+    return {vec4(eye, 1),     vec4(right * tanHalf * aspect, 0), vec4(up * tanHalf, 0),
+            vec4(forward, 0), vec4(-3.0f, 7.0f, 4.0f, 1.0f),     vec4(0, 0, 0, kSphereRadius)};
+}
+
+RenderResult BuiltinScene::render(const RenderSettings& settings) {
+    RenderResult result;
+    result.image = Image(settings.width, settings.height);
+    if (!outputHeap_) outputHeap_ = &device_.createDescriptorHeap(1, "output heap");
+    DescriptorHeap& heap = *outputHeap_;
+    heap.setTexture2D(0, DescriptorRangeType::UAV, &result.image);
+
+    const builtin::SceneConstants constants = sceneConstants(settings.width, settings.height);
     const GpuVirtualAddress cb = device_.memory().upload(&constants, sizeof constants, "scene constants");
 
     GlobalRootArguments globals(globalSignature_);

@@ -6,14 +6,24 @@
 #include <memory>
 
 #include "emulator/device.h"
+#include "procedural/builtin/builtin_shaders.h"
 #include "scenes/render_settings.h"
 
 namespace refray::scenes {
 
 class BuiltinScene {
 public:
+    // The scene's geometry and materials (also used by the raw-Embree benchmark baseline).
+    static constexpr float kPlaneHalfSize = 6.0f;
+    static constexpr vec3 kSphereCentre{0.0f, 1.0f, 0.0f};
+    static constexpr float kSphereRadius = 1.0f;
+    static constexpr vec4 kPlaneAlbedo{0.9f, 0.85f, 0.75f, 0.0f};
+    static constexpr vec4 kSphereAlbedo{0.8f, 0.25f, 0.2f, 0.35f};  // .w: reflectance
+
     BuiltinScene();
     RenderResult render(const RenderSettings& settings);
+    // Camera and light constants for a width x height image.
+    static procedural::builtin::SceneConstants sceneConstants(uint32_t width, uint32_t height);
 
     dxr::Device& device() { return device_; }
     const dxr::StateObjectPtr& pipeline() const { return pipeline_; }
@@ -26,6 +36,7 @@ private:
     dxr::RootSignaturePtr globalSignature_;
     dxr::DispatchRaysDesc tables_;
     dxr::GpuVirtualAddress tlas_ = 0;
+    dxr::DescriptorHeap* outputHeap_ = nullptr;
 };
 
 }  // namespace refray::scenes

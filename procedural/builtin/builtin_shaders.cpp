@@ -11,8 +11,6 @@ using namespace refray::dxr;
 namespace {
 
 constexpr float kTMax = 10000.0f;
-constexpr vec4 kSkyTop{0.35f, 0.55f, 0.9f, 1.0f};
-constexpr vec4 kSkyHorizon{0.85f, 0.9f, 1.0f, 1.0f};
 
 SceneConstants sceneConstants(ShaderContext& ctx) {
     return ctx.load<SceneConstants>(ctx.globalRootDescriptor(kSceneConstants));
@@ -42,30 +40,62 @@ vec3 shade(ShaderContext& ctx, vec3 albedo, vec3 normal, vec3 position, uint32_t
     const vec3 toLight = vec3(sc.lightPosition) - position;
     const float distance = glm::length(toLight);
     const vec3 l = toLight / distance;
-    const float lambert = std::max(0.0f, glm::dot(normal, l));
-    const bool shadowed = lambert > 0.0f && inShadow(ctx, position, l, distance, depth);
-    return albedo * (0.15f + (shadowed ? 0.0f : 0.85f * lambert));
+    const bool shadowed = glm::dot(normal, l) > 0.0f && inShadow(ctx, position, l, distance, depth);
+    return lambert(albedo, normal, l, shadowed);
 }
 
 }  // namespace
+
+vec4 skyColor(vec3 direction) {
+    constexpr vec4 kSkyTop{0.35f, 0.55f, 0.9f, 1.0f};
+    constexpr vec4 kSkyHorizon{0.85f, 0.9f, 1.0f, 1.0f};
+    const float up = std::clamp(glm::normalize(direction).y, 0.0f, 1.0f);
+    return kSkyHorizon + (kSkyTop - kSkyHorizon) * up;
+}
+
+vec3 checkerAlbedo(vec3 p, vec3 albedo) {
+    const bool checker = (int(std::floor(p.x)) + int(std::floor(p.z))) & 1;
+    return albedo * (checker ? 1.0f : 0.55f);
+}
+
+vec3 lambert(vec3 albedo, vec3 normal, vec3 toLightUnit, bool shadowed) {
+    const float cosine = std::max(0.0f, glm::dot(normal, toLightUnit));
+    return albedo * (0.15f + (shadowed ? 0.0f : 0.85f * cosine));
+}
+
+bool intersectSphere(vec3 o, vec3 d, float radius, float tMin, float tMax, float& tHit) {
+    const float a = glm::dot(d, d), b = glm::dot(o, d), c = glm::dot(o, o) - radius * radius;
+    const float disc = b * b - a * c;
+    if (disc < 0.0f) return false;
+    const float root = std::sqrt(disc);
+    for (float t : {(-b - root) / a, (-b + root) / a}) {
+        if (t >= tMin && t <= tMax) {
+            tHit = t;
+            return true;
+        }
+    }
+    return false;
+}
+
+vec3 primaryDirection(const SceneConstants& sc, uvec3 index, uvec3 dims) {
+    const float sx = (float(index.x) + 0.5f) / float(dims.x) * 2.0f - 1.0f;
+    const float sy = -((float(index.y) + 0.5f) / float(dims.y) * 2.0f - 1.0f);
+    return glm::normalize(vec3(sc.cameraForward) + sx * vec3(sc.cameraRight) + sy * vec3(sc.cameraUp));
+}
 
 std::shared_ptr<ShaderLibrary> makeShaderLibrary() {
     auto lib = std::make_shared<ShaderLibrary>();
 
     lib->addRayGeneration("RayGen", [](ShaderContext& ctx) {
         const uvec3 index = ctx.DispatchRaysIndex();
-        const uvec3 dims = ctx.DispatchRaysDimensions();
         const SceneConstants sc = sceneConstants(ctx);
-        const float sx = (float(index.x) + 0.5f) / float(dims.x) * 2.0f - 1.0f;
-        const float sy = -((float(index.y) + 0.5f) / float(dims.y) * 2.0f - 1.0f);
-        const vec3 d = glm::normalize(vec3(sc.cameraForward) + sx * vec3(sc.cameraRight) + sy * vec3(sc.cameraUp));
+        const vec3 d = primaryDirection(sc, index, ctx.DispatchRaysDimensions());
         const vec4 color = traceRadiance(ctx, vec3(sc.cameraPosition), d, 0);
         ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputTable)).at(index.x, index.y) = color;
     });
 
     lib->addMiss<RadiancePayload>("Miss", [](ShaderContext& ctx, RadiancePayload& payload) {
-        const float up = std::clamp(glm::normalize(ctx.WorldRayDirection()).y, 0.0f, 1.0f);
-        payload.color = kSkyHorizon + (kSkyTop - kSkyHorizon) * up;
+        payload.color = skyColor(ctx.WorldRayDirection());
     });
 
     lib->addMiss<ShadowPayload>("Miss_Shadow", [](ShaderContext&, ShadowPayload& payload) { payload.hit = 0; });
@@ -74,9 +104,7 @@ std::shared_ptr<ShaderLibrary> makeShaderLibrary() {
         "ClosestHit_Plane", [](ShaderContext& ctx, RadiancePayload& payload, const BuiltInTriangleIntersectionAttributes&) {
             const MaterialConstants m = ctx.localRootConstants<MaterialConstants>(kMaterialParameter);
             const vec3 p = hitWorldPosition(ctx);
-            const bool checker = (int(std::floor(p.x)) + int(std::floor(p.z))) & 1;
-            const vec3 albedo = vec3(m.albedo) * (checker ? 1.0f : 0.55f);
-            payload.color = vec4(shade(ctx, albedo, vec3(0.0f, 1.0f, 0.0f), p, payload.recursionDepth), 1.0f);
+            payload.color = vec4(shade(ctx, checkerAlbedo(p, vec3(m.albedo)), vec3(0.0f, 1.0f, 0.0f), p, payload.recursionDepth), 1.0f);
         });
 
     // Analytic sphere in object space; reports t in the caller's (object = world) units.
@@ -85,16 +113,9 @@ std::shared_ptr<ShaderLibrary> makeShaderLibrary() {
         const vec3 centre = vec3(sc.sphere);
         const float radius = sc.sphere.w;
         const vec3 o = ctx.ObjectRayOrigin() - centre, d = ctx.ObjectRayDirection();
-        const float a = glm::dot(d, d), b = glm::dot(o, d), c = glm::dot(o, o) - radius * radius;
-        const float disc = b * b - a * c;
-        if (disc < 0.0f) return;
-        const float root = std::sqrt(disc);
-        for (float t : {(-b - root) / a, (-b + root) / a}) {
-            if (t >= ctx.RayTMin() && t <= ctx.RayTCurrent()) {
-                ctx.ReportHit(t, 0, SphereAttributes{(o + t * d) / radius});
-                return;
-            }
-        }
+        float t;
+        if (intersectSphere(o, d, radius, ctx.RayTMin(), ctx.RayTCurrent(), t))
+            ctx.ReportHit(t, 0, SphereAttributes{(o + t * d) / radius});
     });
 
     lib->addClosestHit<RadiancePayload, SphereAttributes>(

@@ -51,4 +51,15 @@ inline constexpr uint32_t kMaxRecursionDepth = 3;
 
 std::shared_ptr<dxr::ShaderLibrary> makeShaderLibrary();
 
+// The shading math, shared by the shaders and by the raw-Embree baseline of the
+// emulation-overhead benchmark (so both do exactly the same work per ray).
+vec4 skyColor(vec3 direction);
+vec3 checkerAlbedo(vec3 position, vec3 albedo);
+// Lambert with a fixed ambient term; `shadowed` is the shadow ray's answer.
+vec3 lambert(vec3 albedo, vec3 normal, vec3 toLightUnit, bool shadowed);
+// Nearest root of |o + t d - centre| = radius within [tMin, tMax], if any.
+bool intersectSphere(vec3 origin, vec3 direction, float radius, float tMin, float tMax, float& tHit);
+// The primary ray direction of pixel `index` (pinhole, pixel centre).
+vec3 primaryDirection(const SceneConstants& sc, uvec3 index, uvec3 dims);
+
 }  // namespace refray::procedural::builtin

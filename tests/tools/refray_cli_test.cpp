@@ -1,0 +1,73 @@
+// The refray command line as a user runs it.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "core/image.h"
+
+namespace {
+
+struct CliRun {
+    int status;
+    std::string output;
+};
+
+CliRun run(const std::string& arguments) {
+    const std::string command = std::string(REFRAY_BINARY) + " " + arguments + " 2>&1";
+    FILE* pipe = popen(command.c_str(), "r");
+    CliRun r{-1, {}};
+    if (!pipe) return r;
+    std::array<char, 4096> buffer;
+    while (fgets(buffer.data(), int(buffer.size()), pipe)) r.output += buffer.data();
+    const int status = pclose(pipe);
+    r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+}
+
+std::string outputPath(const std::string& name) {
+    std::filesystem::create_directories(REFRAY_TEST_OUTPUT_DIR);
+    return std::string(REFRAY_TEST_OUTPUT_DIR) + "/" + name;
+}
+
+}  // namespace
+
+TEST(RefrayCli, RenderWritesAPngWithProvenance) {
+    const std::string path = outputPath("cli.png");
+    std::filesystem::remove(path);
+    const CliRun r = run("render -o " + path + " --size 64x36 --threads 2 --stats");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("rays at depth 1: 2304"), std::string::npos) << r.output;
+    const refray::Image image = refray::readImage(path);
+    EXPECT_EQ(image.width(), 64u);
+    EXPECT_EQ(image.height(), 36u);
+    EXPECT_EQ(image.metadata.at("scene"), "builtin");
+    EXPECT_EQ(image.metadata.at("size"), "64x36");
+    EXPECT_TRUE(image.metadata.count("refray_commit"));
+}
+
+TEST(RefrayCli, ExrKeepsFloats) {
+    const std::string path = outputPath("cli.exr");
+    ASSERT_EQ(run("render -o " + path + " --size 32x18").status, 0);
+    EXPECT_EQ(refray::readImage(path).width(), 32u);
+}
+
+TEST(RefrayCli, BadSizeIsAClearError) {
+    const CliRun r = run("render -o " + outputPath("bad.png") + " --size 64by36");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("--size expects WIDTHxHEIGHT"), std::string::npos) << r.output;
+}
+
+TEST(RefrayCli, UnknownOrderIsAClearError) {
+    const CliRun r = run("render -o " + outputPath("bad.png") + " --size 8x8 --order random");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("--order expects"), std::string::npos) << r.output;
+}
+
+TEST(RefrayCli, UnwritablePathNamesIt) {
+    const CliRun r = run("render -o /proc/refray-cannot-write.png --size 8x8");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("/proc/refray-cannot-write.png"), std::string::npos) << r.output;
+}

@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# One command from a fresh Debian 12 machine to a render: installs refray's packages
+# (tools/setup.sh), configures and builds the release preset when needed, then runs
+# `refray` with the given arguments, e.g.  bash tools/refray.sh render -o refray.png
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+bash tools/setup.sh >&2
+if [ ! -f build/release/build.ninja ]; then
+  echo "refray.sh: configuring build/release" >&2
+  cmake --preset release >&2
+fi
+echo "refray.sh: building (first time: a few minutes on 2 cores)" >&2
+cmake --build build/release --target refray -j "$(nproc)" >&2
+exec build/release/tools/refray "$@"
