@@ -125,6 +125,7 @@ struct BuiltGeometry {
     // AABBs: as declared, with inverted boxes collapsed to their centre point (DEGEN-8).
     std::vector<RaytracingAABB> aabbs;
     std::vector<uint8_t> active;
+    std::vector<uint32_t> indices;  // the index buffer as built (UPD-2 forbids changing it)
     uint32_t primitiveCount() const { return uint32_t(active.size()); }
 };
 

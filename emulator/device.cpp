@@ -244,7 +244,11 @@ BuiltGeometry buildGeometry(const GpuMemory& memory, const GeometryDesc& desc, u
     static const char* axis[3] = {"x", "y", "z"};
     for (uint32_t tri = 0; tri < triangleCount; ++tri) {
         vec3 v[3];
-        for (int k = 0; k < 3; ++k) v[k] = vertex(index(tri * 3 + k));
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t i = index(tri * 3 + k);
+            if (indexBytes) out.indices.push_back(i);
+            v[k] = vertex(i);
+        }
         if (std::isnan(v[0].x) || std::isnan(v[1].x) || std::isnan(v[2].x)) {
             out.active[tri] = 0;  // DEGEN-1
         } else {
@@ -342,6 +346,10 @@ GpuVirtualAddress Device::buildBottomLevelAS(const BottomLevelInputs& inputs, Gp
         BottomLevelAS& blas = *it->second;
         checkUpdateSource(blas.buildFlags_, inputs.Flags, "BLAS");
         checkBottomLevelUpdate(blas.inputs_, inputs);
+        for (size_t g = 0; g < geometries.size(); ++g)
+            if (geometries[g].indices != blas.geometries_[g].indices)
+                throw DxrError(diag("UPD-2", "BLAS update changes the index data of " + geometryName(uint32_t(g)))
+                                   .value("geometry", g));
         for (size_t g = 0; g < geometries.size(); ++g)
             for (size_t p = 0; p < geometries[g].active.size(); ++p)
                 if (geometries[g].active[p] != blas.geometries_[g].active[p])

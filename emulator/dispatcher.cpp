@@ -194,6 +194,13 @@ bool lookupRecord(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
         return false;
     }
     const uint64_t available = table.StrideInBytes ? table.StrideInBytes : table.SizeInBytes - offset;
+    if (kind == ProgramEntry::Kind::RayGeneration && table.SizeInBytes < layout) {
+        // The ray generation record has no stride: its SizeInBytes must cover it (IDX-9).
+        raise(ts, site, diag("IDX-9", "RayGenerationShaderRecord.SizeInBytes does not cover the identifier and local root "
+                                      "arguments of '" + entry->name + "'")
+                            .value("SizeInBytes", table.SizeInBytes, ">= " + std::to_string(layout)));
+        return false;
+    }
     if (available < layout || offset + layout > table.SizeInBytes) {
         auto b = diag(available < layout ? "REC-11" : "IDX-11",
                       "the record of '" + entry->name + "' does not fit in the " + std::string(name));
@@ -264,6 +271,7 @@ AnyHitOutcome runAnyHit(ThreadState& ts, RayState& rs, const RecordView& record,
     inv.dispatch = ts.dispatch;
     inv.thread = &ts;
     inv.depth = rs.depth;
+    checkGlobalSignature(ts, siteOf(inv), *record.entry);
     checkPayload(ts, siteOf(inv), *inv.shader, rs.payloadType);
     try {
         invoke(ts, inv, rs.payload, candidate.attributes);
@@ -971,11 +979,6 @@ DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObj
                                .value("SizeInBytes", rg.SizeInBytes, ">= 32"));
         detail::lookupRecord(probe, site, ProgramEntry::Kind::RayGeneration, rg, 0, ds.rayGenRecord);
         ds.options = options;
-        if (ds.rayGenRecord.entry && ds.rayGenRecord.entry->localRootSignature &&
-            rg.SizeInBytes < ds.rayGenRecord.entry->localRootSignature->recordSize())
-            throw DxrError(diag("IDX-9", "RayGenerationShaderRecord.SizeInBytes does not cover the identifier and local root arguments")
-                               .value("SizeInBytes", rg.SizeInBytes,
-                                      ">= " + std::to_string(ds.rayGenRecord.entry->localRootSignature->recordSize())));
     }
     DispatchResult result;
     if (!ds.rayGenRecord.entry || threads == 0) {  // REC-8: NULL ray generation; RGS-1: zero size

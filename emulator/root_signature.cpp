@@ -84,7 +84,8 @@ std::shared_ptr<const RootSignature> RootSignature::create(RootSignatureDesc des
     uint32_t offset = kShaderIdentifierSizeInBytes;
     for (uint32_t i = 0; i < signature->parameterCount(); ++i) {
         const uint32_t size = signature->argumentSize(i);
-        if (size == 8) offset = (offset + 7u) & ~7u;
+        // Only GPU addresses and descriptor handles are 8-byte aligned; constants pack at 4.
+        if (signature->parameter(i).parameterType != RootParameterType::Constants32Bit) offset = (offset + 7u) & ~7u;
         signature->offsets_.push_back(offset);
         offset += size;
     }

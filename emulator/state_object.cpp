@@ -112,6 +112,44 @@ RootSignaturePtr resolveAssociation(const std::vector<RootSignatureAssociation>&
     return pickUnique(defaults, "default");
 }
 
+struct RegisterRange {
+    char kind;  // b, t, u, s
+    uint32_t space, first, last;
+};
+
+std::vector<RegisterRange> registersOf(const RootSignature& signature) {
+    std::vector<RegisterRange> out;
+    for (uint32_t i = 0; i < signature.parameterCount(); ++i) {
+        const RootParameter& p = signature.parameter(i);
+        switch (p.parameterType) {
+            case RootParameterType::Constants32Bit:
+            case RootParameterType::CBV: out.push_back({'b', p.registerSpace, p.shaderRegister, p.shaderRegister}); break;
+            case RootParameterType::SRV: out.push_back({'t', p.registerSpace, p.shaderRegister, p.shaderRegister}); break;
+            case RootParameterType::UAV: out.push_back({'u', p.registerSpace, p.shaderRegister, p.shaderRegister}); break;
+            case RootParameterType::DescriptorTable:
+                for (const DescriptorRange& r : p.ranges) {
+                    static const char kinds[] = {'t', 'u', 'b', 's'};  // SRV, UAV, CBV, Sampler
+                    const uint32_t last = r.numDescriptors == ~0u ? ~0u : r.baseShaderRegister + r.numDescriptors - 1;
+                    out.push_back({kinds[size_t(r.rangeType)], r.registerSpace, r.baseShaderRegister, last});
+                }
+                break;
+        }
+    }
+    return out;
+}
+
+// PIPE-7: a shader's local root signature must not bind registers its global one binds.
+void checkRegisterOverlap(const std::string& exportName, const RootSignaturePtr& local, const RootSignaturePtr& global) {
+    if (!local || !global) return;
+    for (const RegisterRange& l : registersOf(*local))
+        for (const RegisterRange& g : registersOf(*global))
+            if (l.kind == g.kind && l.space == g.space && l.first <= g.last && g.first <= l.last)
+                throw DxrError(diag("PIPE-7", "export '" + exportName + "': local root signature '" + local->name() +
+                                                  "' and global root signature '" + global->name() + "' share a register")
+                                   .value("register", std::string(1, l.kind) + std::to_string(std::max(l.first, g.first)))
+                                   .value("space", l.space));
+}
+
 }  // namespace
 
 std::shared_ptr<const StateObject> StateObject::create(const StateObjectDesc& desc) {
@@ -208,6 +246,7 @@ std::shared_ptr<const StateObject> StateObject::create(const StateObjectDesc& de
     }
 
     auto addEntry = [&](ProgramEntry e) {
+        checkRegisterOverlap(e.name, e.localRootSignature, e.globalRootSignature);
         e.index = uint32_t(so->entries_.size());
         e.identifier = makeIdentifier(so->familyId_, e.index, e.kind, e.name);
         so->byName_[e.name] = e.index;
