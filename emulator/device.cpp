@@ -450,8 +450,7 @@ GpuVirtualAddress Device::buildTopLevelAS(const TopLevelInputs& inputs, GpuVirtu
                                .value("before", tlas.instances_.size())
                                .value("after", instances.size()));
         for (size_t i = 0; i < instances.size(); ++i)
-            if ((tlas.instances_[i].blas == nullptr) != (instances[i].blas == nullptr) &&
-                (tlas.instances_[i].desc.AccelerationStructure == 0) != (instances[i].desc.AccelerationStructure == 0))
+            if ((tlas.instances_[i].desc.AccelerationStructure == 0) != (instances[i].desc.AccelerationStructure == 0))
                 throw DxrError(diag("DEGEN-5", "TLAS update changes whether instance " + std::to_string(i) + " is active")
                                    .value("InstanceIndex", i));
         tlas.instances_ = std::move(instances);

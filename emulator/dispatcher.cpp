@@ -49,6 +49,7 @@ struct ThreadState {
     std::vector<Candidate> candidates;
     uint64_t rayCounter = 0;
     std::vector<Diagnostic> stopErrors;  // OnError::Stop: the errors that ended a launch
+    std::vector<const ShaderExport*> callChain;  // the shaders running on this launch, outermost first
     GpuVirtualAddress lastTlasAddress = 0;  // one-entry cache of the TLAS lookup
     const TopLevelAS* lastTlas = nullptr;
 };
@@ -241,7 +242,21 @@ void checkPayload(ThreadState& ts, const Site& site, const ShaderExport& shader,
 void invoke(ThreadState& ts, Invocation& inv, void* payload, const void* attributes) {
     ts.stats.invocations[size_t(inv.stage)]++;
     ShaderContext ctx(inv);
+    struct ChainEntry {  // pops on every exit, including non-local ones
+        std::vector<const ShaderExport*>& chain;
+        ~ChainEntry() { chain.pop_back(); }
+    } entry{ts.callChain};
+    ts.callChain.push_back(inv.shader);
     inv.shader->function(ctx, payload, attributes);
+}
+
+std::string describeCallChain(const ThreadState& ts) {
+    std::string out;
+    for (const ShaderExport* s : ts.callChain) {
+        if (!out.empty()) out += " -> ";
+        out += std::string(toString(s->stage)) + " '" + s->name + "'";
+    }
+    return out;
 }
 
 bool isOpaque(uint32_t geometryFlags, uint32_t instanceFlags, uint32_t rayFlags) {  // OPQ-1
@@ -309,16 +324,16 @@ bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attrib
         raise(ts, site, diag("IS-3", "ReportHit called with a NaN THit; the hit is rejected").value("THit", tHit));
         return false;
     }
-    if (tHit < rs.ray.TMin || tHit > rs.tCurrent) return false;  // IS-3: closed interval
-    if (hitKind > kMaxProceduralHitKind)
-        raise(ts, site, diag("IS-4", "ReportHit HitKind outside 0..127 (254 and 255 mean triangle faces)")
-                            .value("HitKind", hitKind, "0..127"));
-    if (!(type == group.attributes)) {
+    if (!(type == group.attributes)) {  // IS-5: checked on every call, in range or not
         raise(ts, site, diag("IS-5", "ReportHit attributes are not the type hit group '" + group.name + "' consumes")
                             .value("reported", type.name() + " (" + std::to_string(type.size) + " B)")
                             .value("expected", group.attributes.name() + " (" + std::to_string(group.attributes.size) + " B)"));
         return false;
     }
+    if (tHit < rs.ray.TMin || tHit > rs.tCurrent) return false;  // IS-3: closed interval
+    if (hitKind > kMaxProceduralHitKind)
+        raise(ts, site, diag("IS-4", "ReportHit HitKind outside 0..127 (254 and 255 mean triangle faces)")
+                            .value("HitKind", hitKind, "0..127"));
     HitInfo candidate = *inv.hit;
     candidate.t = tHit;
     candidate.hitKind = hitKind;
@@ -542,7 +557,7 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
     if (caller.depth >= ds.pipeline->maxTraceRecursionDepth()) {  // LIM-2
         raise(ts, site, diag("LIM-2", "TraceRay at the recursion limit: a call at depth == MaxTraceRecursionDepth removes the device")
                             .value("depth", caller.depth, "< MaxTraceRecursionDepth " + std::to_string(ds.pipeline->maxTraceRecursionDepth()))
-                            .value("call chain", std::string(toString(caller.stage)) + " '" + *site.exportName + "'"));
+                            .value("call chain", describeCallChain(ts)));
         return;  // fallback: the call does nothing
     }
     if (rayFlags & ~kDefinedRayFlags) {  // RAY-10
@@ -588,7 +603,10 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
     ts.stats.raysPerDepth[rs.depth]++;
     ts.rayCounter++;
 
-    if (asAddress != 0) {
+    // RAY-7: an infinite origin or direction component makes the plain math NaN, so the
+    // ray finds nothing (and Embree, which refuses such rays, never sees it).
+    const bool traceable = allFinite(ray.Origin) && allFinite(ray.Direction);
+    if (asAddress != 0 && traceable) {
         if (asAddress != ts.lastTlasAddress) {
             ts.lastTlas = ds.device->findTopLevelAS(asAddress);
             ts.lastTlasAddress = ts.lastTlas ? asAddress : 0;

@@ -1248,6 +1248,59 @@ TEST(AccelerationStructure, DEGEN_5_TlasUpdateFlippingInstanceActiveStatusRefuse
     EXPECT_EQ(valueOf(d, "InstanceIndex"), "1");
 }
 
+TEST(AccelerationStructure, DEGEN_5_TlasUpdateMakingInactiveInstanceActiveRefused) {
+    Rig r;
+    const auto blas = r.h.blas({r.h.triangles(kTri)});
+    std::vector<InstanceDesc> inst = {Harness::instance(blas), Harness::instance(0)};
+    const auto descs = r.h.device.memory().upload(inst, "instances");
+    const auto tlas = r.h.device.buildTopLevelAS({BUILD_FLAG_ALLOW_UPDATE, 2, ElementsLayout::Array, descs});
+    inst[1].AccelerationStructure = blas;
+    r.h.device.memory().write(descs, inst.data(), sizeof(InstanceDesc) * 2);
+    const auto d = expectDxrError("DEGEN-5", [&] {
+        r.h.device.buildTopLevelAS({BUILD_FLAG_ALLOW_UPDATE | BUILD_FLAG_PERFORM_UPDATE, 2, ElementsLayout::Array, descs}, tlas);
+    });
+    EXPECT_EQ(valueOf(d, "InstanceIndex"), "1");
+}
+
+TEST(AccelerationStructure, DEGEN_5_InstanceActivityFollowsItsAddressNotItsTransform) {
+    // DEGEN-1: only a BLAS address of 0 makes an instance inactive. An instance with a
+    // singular transform (INST-9: traversed as if inactive) is still active, so an update that
+    // sets its address to 0 makes an active instance inactive, and the reverse too.
+    Rig r;
+    const auto blas = r.h.blas({r.h.triangles(kTri)});
+    std::vector<InstanceDesc> inst = {Harness::instance(blas, 0, Matrix3x4::scale({1, 1, 0}))};
+    const auto descs = r.h.device.memory().upload(inst, "instances");
+    const auto tlas = r.h.device.buildTopLevelAS({BUILD_FLAG_ALLOW_UPDATE, 1, ElementsLayout::Array, descs});
+    inst[0].AccelerationStructure = 0;
+    r.h.device.memory().write(descs, inst.data(), sizeof(InstanceDesc));
+    const uint32_t update = BUILD_FLAG_ALLOW_UPDATE | BUILD_FLAG_PERFORM_UPDATE;
+    expectDxrError("DEGEN-5", [&] { r.h.device.buildTopLevelAS({update, 1, ElementsLayout::Array, descs}, tlas); });
+
+    std::vector<InstanceDesc> nullFirst = {Harness::instance(0)};
+    const auto descs2 = r.h.device.memory().upload(nullFirst, "instances2");
+    const auto tlas2 = r.h.device.buildTopLevelAS({BUILD_FLAG_ALLOW_UPDATE, 1, ElementsLayout::Array, descs2});
+    nullFirst[0] = Harness::instance(blas, 0, Matrix3x4::scale({0, 0, 0}));
+    r.h.device.memory().write(descs2, nullFirst.data(), sizeof(InstanceDesc));
+    expectDxrError("DEGEN-5", [&] { r.h.device.buildTopLevelAS({update, 1, ElementsLayout::Array, descs2}, tlas2); });
+}
+
+TEST(AccelerationStructure, DEGEN_6_InstanceOfBlasWithoutActivePrimitiveStaysActive) {
+    // Degenerate (its BLAS has no active primitive) but active: making it null is DEGEN-5.
+    Rig r;
+    const auto empty = r.h.blas({r.h.triangles({{kNaN, 0, 0}, {0, 1, 0}, {1, 0, 0}})});
+    EXPECT_FALSE(r.h.device.findBottomLevelAS(empty)->hasActivePrimitive());
+    std::vector<InstanceDesc> inst = {Harness::instance(empty)};
+    const auto descs = r.h.device.memory().upload(inst, "instances");
+    const auto tlas = r.h.device.buildTopLevelAS({BUILD_FLAG_ALLOW_UPDATE, 1, ElementsLayout::Array, descs});
+    r.h.scene = tlas;
+    EXPECT_EQ(r.traceOne(zRay(0.5f, 0.25f)).misses, 1u);
+    inst[0].AccelerationStructure = 0;
+    r.h.device.memory().write(descs, inst.data(), sizeof(InstanceDesc));
+    expectDxrError("DEGEN-5", [&] {
+        r.h.device.buildTopLevelAS({BUILD_FLAG_ALLOW_UPDATE | BUILD_FLAG_PERFORM_UPDATE, 1, ElementsLayout::Array, descs}, tlas);
+    });
+}
+
 TEST(AccelerationStructure, DEGEN_6_UpdateMayMoveTriangleOutOfDegeneracy) {
     Rig r;
     GeometryDesc g = r.h.triangles({{-1, 0, 0}, {0, 0, 0}, {1, 0, 0}});  // collinear: degenerate but active

@@ -372,16 +372,28 @@ TEST(Dispatcher, RAY_7_ZeroDirectionWarnsAndDoesNotHit) {
     EXPECT_TRUE(result.diagnostics.errors().empty());
 }
 
-TEST(Dispatcher, RAY_7_InfiniteOriginComponentWarns) {
-    Rig r;
-    const auto tri = r.h.blas({r.h.triangles(triAt(0))});
-    r.h.tlas({Harness::instance(tri)});
-    r.ray.Origin.x = kInf;
-    const auto result = r.run({"HG_Tri"});
-    const auto w = result.diagnostics.find("RAY-7");
-    ASSERT_TRUE(w);
-    EXPECT_EQ(w->severity, Severity::Warning);
-    EXPECT_EQ(r.result.closestHits, 0u);
+TEST(Dispatcher, RAY_7_InfiniteOriginOrDirectionComponentWarnsAndMisses) {
+    // Runs in a child process: a crash inside the traversal must fail this test only.
+    GTEST_FLAG_SET(death_test_style, "threadsafe");
+    for (int which = 0; which < 2; ++which) {
+        SCOPED_TRACE(which == 0 ? "Origin.x = +inf" : "Direction.x = +inf");
+        EXPECT_EXIT(
+            {
+                Rig r;
+                r.h.tlas({Harness::instance(r.h.blas({r.h.triangles(triAt(0))}))});
+                if (which == 0) r.ray.Origin.x = kInf;
+                else r.ray.Direction.x = kInf;
+                DispatchOptions o;
+                o.threads = 1;
+                const auto result = r.run({"HG_Tri"}, uvec3(1u), o);
+                const auto w = result.diagnostics.find("RAY-7");
+                const bool ok = w && w->severity == Severity::Warning && result.diagnostics.errors().empty() &&
+                                r.result.closestHits == 0 && r.result.misses == 1;
+                std::fflush(nullptr);
+                std::_Exit(ok ? 0 : 1);
+            },
+            ::testing::ExitedWithCode(0), "");
+    }
 }
 
 TEST(Dispatcher, RAY_8_TMinNeverChangesAndTCurrentOnlyDecreasesOnCommit) {
@@ -600,6 +612,29 @@ TEST(Dispatcher, FLAG_8_FirstCommittedWinsEvenIfNearerGeometryIsNotVisited) {
     EXPECT_EQ(r.isCalls.load(), 1);
 }
 
+TEST(Dispatcher, FLAG_8_IgnoreHitInsideReportHitCancelsTheEndForThatCandidate) {
+    Rig r;
+    r.h.tlas({Harness::instance(r.h.blas({r.h.aabbs({unitBox()}, GEOMETRY_FLAG_NONE)}))});
+    std::vector<bool> results;
+    int after = 0;
+    r.is = [&](ShaderContext& ctx) {
+        results.push_back(ctx.ReportHit(8.0f, 1, ProbeAttributes{}));  // ignored by the AHS: the search goes on
+        results.push_back(ctx.ReportHit(9.0f, 2, ProbeAttributes{}));  // accepted: ends inside ReportHit
+        ++after;
+    };
+    r.ahBox = [](ShaderContext& ctx, Probe&, const ProbeAttributes&) {
+        if (ctx.HitKind() == 1) ctx.IgnoreHit();
+    };
+    r.args.flags = RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH;
+    r.run({"HG_BoxS"});
+    EXPECT_EQ(results, (std::vector<bool>{false}));
+    EXPECT_EQ(after, 0);
+    EXPECT_EQ(r.result.anyHits, 2u);
+    EXPECT_EQ(r.result.closestHits, 1u);
+    EXPECT_EQ(r.result.hitKind, 2u);
+    EXPECT_EQ(r.result.t, 9.0f);
+}
+
 TEST(Dispatcher, FLAG_9_SkipClosestHitRunsNoClosestHitButMissAndAnyHitStillRun) {
     Rig r;
     const auto tri = r.h.blas({r.h.triangles(triAt(0), GEOMETRY_FLAG_NONE)});
@@ -644,7 +679,9 @@ TEST(Dispatcher, FLAG_10_FaceCullingAndTriangleCullDisable) {
         r.args.flags = c.flags;
         r.run({"HG_TriS_noAH"});
         EXPECT_EQ(r.result.closestHits, c.hit ? 1u : 0u);
-        if (c.hit) EXPECT_EQ(r.result.hitKind, c.kind);
+        if (c.hit) {
+            EXPECT_EQ(r.result.hitKind, c.kind);
+        }
     }
     // No effect on procedural primitives.
     r.h.tlas({Harness::instance(box)});
@@ -679,7 +716,9 @@ TEST(Dispatcher, FLAG_11_CullOpaqueAndNonOpaqueOnTrianglesAndAABBs) {
             EXPECT_EQ(r.result.closestHits, culled ? 0u : 1u);
             EXPECT_EQ(r.result.misses, culled ? 1u : 0u);
             EXPECT_EQ(r.result.anyHits, culled || c.opaque ? 0u : 1u);
-            if (c.procedural) EXPECT_EQ(r.isCalls.load(), culled ? 0 : 1);  // a culled AABB's IS never runs
+            if (c.procedural) {
+                EXPECT_EQ(r.isCalls.load(), culled ? 0 : 1);  // a culled AABB's IS never runs
+            }
         }
     }
 }
@@ -1137,6 +1176,13 @@ TEST(Dispatcher, IS_5_AttributeTypeMismatchIsAnError) {
     const auto d = expectDxrError("IS-5", [&] { r.run({"HG_BoxS"}); });
     EXPECT_TRUE(contains(valueOf(d, "reported"), "OtherAttributes")) << d.format();
     EXPECT_TRUE(contains(valueOf(d, "expected"), "ProbeAttributes")) << d.format();
+}
+
+TEST(Dispatcher, IS_5_AttributeTypeIsCheckedOnEveryReportHitEvenARejectedOne) {
+    Rig r;
+    r.h.tlas({Harness::instance(r.h.blas({r.h.aabbs({unitBox()})}))});
+    r.is = [](ShaderContext& ctx) { ctx.ReportHit(1000.0f, 0, OtherAttributes{1, 2}); };  // beyond TMax
+    expectDxrError("IS-5", [&] { r.run({"HG_BoxS"}); });
 }
 
 TEST(Dispatcher, IS_6_OpaqueInRangeCommitsAtOnceWithoutAnyHit) {
@@ -2152,6 +2198,24 @@ TEST(Dispatcher, LIM_2_TraceRayAtTheLimitIsAnErrorNamingDepthAndLimit) {
     EXPECT_TRUE(contains(valueOf(d, "call chain"), "CH_TriS")) << d.format();
 }
 
+TEST(Dispatcher, LIM_2_DiagnosticNamesTheWholeCallChain) {
+    Rig r;
+    r.recursion(2);
+    r.h.tlas({Harness::instance(r.h.blas({r.h.triangles(triAt(0))}))});
+    r.chTri = [&](ShaderContext& ctx, Probe& p, const BuiltInTriangleIntersectionAttributes&) {
+        Probe q;
+        q.tag = p.tag + 1;
+        ctx.TraceRay(r.h.scene, RAY_FLAG_NONE, 0xFF, 0, 1, 0, zRay(), q);  // the CHS at depth 2 breaks the limit
+    };
+    const auto d = expectDxrError("LIM-2", [&] { r.run({"HG_TriS_noAH"}); });
+    EXPECT_EQ(valueOf(d, "depth"), "2");
+    ASSERT_TRUE(d.site);
+    EXPECT_EQ(d.site->depth, 2u);
+    const std::string chain = valueOf(d, "call chain");
+    EXPECT_TRUE(contains(chain, "RG")) << "the call chain should start at the ray generation shader: " << d.format();
+    EXPECT_TRUE(contains(chain, "CH_TriS")) << d.format();
+}
+
 TEST(Dispatcher, LIM_2_LimitZeroForbidsTraceRayFromRayGeneration) {
     Rig r;
     r.recursion(0);
@@ -2301,6 +2365,7 @@ TEST(Dispatcher, GEN_3_AdversarialSeedsChangeOrderNotOrderIndependentResults) {
         o.order = TraversalOrder::Adversarial;
         o.adversarialSeed = seed;
         report = false;
+        order.clear();
         r.run({"HG_BoxS"}, uvec3(1u), o);
         std::vector<uint32_t> unique = order;
         std::sort(unique.begin(), unique.end());
@@ -2319,6 +2384,7 @@ TEST(Dispatcher, GEN_3_AdversarialSeedsChangeOrderNotOrderIndependentResults) {
     o.order = TraversalOrder::Adversarial;
     o.adversarialSeed = 1;
     report = false;
+    order.clear();
     r.run({"HG_BoxS"}, uvec3(1u), o);
     EXPECT_EQ(order, firstPass[0]);
 }

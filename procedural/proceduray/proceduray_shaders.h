@@ -1,0 +1,187 @@
+// Ports: Proceduray (dsilvavinicius/Proceduray) Raytracing.hlsl, Helpers.hlsli, Triangles.hlsli, Pacman.hlsli,
+// JuliaSets.hlsli, Mandelbulb.hlsli entry points, and the structs of engine/{Payloads,AttribStructs,RootComponents,
+// RootArguments,ShaderCompat}.h. Facts: docs reference-scene-proceduray.md (§1.3-1.8, §3, §4, §5).
+//
+// The "MandelJuliaPac" shader library: ray generation, two miss shaders, the slab's closest hit and the
+// intersection / closest-hit pairs of the Julia set, the Pac-man and the Mandelbulb. The pure math lives in
+// procedural/math/; the entry points here transform the ray, call it, shade and TraceRay exactly as the HLSL
+// does, including its t-space bug (H1: intersection shaders report t in normalised local units).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/math.h"
+#include "emulator/root_signature.h"
+#include "emulator/state_object.h"
+
+namespace refray::procedural::proceduray {
+
+// ---- Shader-visible structs (HLSL layout; the C++ side of the shared headers) ---------------------
+
+// An HLSL float4x4 compiled with /Zpr: row-major, used with row vectors (mul(v, M) = v·M, translation
+// in row 3). Same memory layout as a DirectXMath XMMATRIX.
+struct Float4x4 {
+    std::array<std::array<float, 4>, 4> m{};
+};
+static_assert(sizeof(Float4x4) == 64);
+
+// engine/Payloads.h. `hit` is an HLSL bool, i.e. a 32-bit value.
+struct RayPayload {
+    vec4 color;
+    uint32_t recursionDepth;
+    float dist;
+    int32_t count;
+    uint32_t hit;
+};
+static_assert(sizeof(RayPayload) == 32);
+
+struct ShadowRayPayload {
+    float dist;
+    uint32_t hit;
+};
+static_assert(sizeof(ShadowRayPayload) == 8);
+
+// engine/AttribStructs.h: 28 bytes, under the 32-byte attribute limit.
+struct ProceduralPrimitiveAttributes {
+    vec3 normal;
+    vec4 color;
+};
+static_assert(sizeof(ProceduralPrimitiveAttributes) == 28);
+
+// engine/RootComponents.h: the material (12 root constants at b1).
+struct PrimitiveConstantBuffer {
+    vec4 albedo;
+    float reflectanceCoef;
+    float diffuseCoef;
+    float specularCoef;
+    float specularPower;
+    float stepScale;  // read by the Pac-man march only
+    vec3 padding;
+};
+static_assert(sizeof(PrimitiveConstantBuffer) == 48);
+
+// Per procedural instance (2 root constants at b2). instanceIndex is the procedural ordinal (0..3), not
+// InstanceIndex(); primitiveType is a SignedDistancePrimitive.
+struct PrimitiveInstanceConstantBuffer {
+    uint32_t instanceIndex;
+    uint32_t primitiveType;
+};
+static_assert(sizeof(PrimitiveInstanceConstantBuffer) == 8);
+
+// engine/RootArguments.h: the record bytes after the identifier.
+struct TriangleRootArguments {
+    PrimitiveConstantBuffer materialCb;
+};
+static_assert(sizeof(TriangleRootArguments) == 48);
+struct ProceduralRootArguments {
+    PrimitiveConstantBuffer materialCb;
+    PrimitiveInstanceConstantBuffer aabbCB;
+};
+static_assert(sizeof(ProceduralRootArguments) == 56);
+
+// The root CBV b0. The HLSL cbuffer uses 140 bytes; the C++ struct (XMMATRIX-aligned) is 144.
+struct SceneConstantBuffer {
+    Float4x4 projectionToWorld;
+    vec4 cameraPosition;
+    vec4 lightPosition;
+    vec4 lightAmbientColor;
+    vec4 lightDiffuseColor;
+    float reflectance;  // never written or read (§1.7)
+    float elapsedTime;
+    int32_t debugFlag;
+    uint32_t padding;
+};
+static_assert(sizeof(SceneConstantBuffer) == 144);
+
+// One element of StructuredBuffer<InstanceBuffer> (root SRV t3), indexed by l_aabbCB.instanceIndex.
+// Despite the name, localSpaceToBottomLevelAS holds world -> object, i.e. inverse(M) (§1.7, §5.3).
+struct InstanceBuffer {
+    Float4x4 localSpaceToBottomLevelAS;
+    Float4x4 bottomLevelASToLocalSpace;
+};
+static_assert(sizeof(InstanceBuffer) == 128);
+
+// engine/ShaderCompat.h: the slab's vertex (StructuredBuffer<Vertex>, 24-byte stride).
+struct Vertex {
+    vec3 position;
+    vec3 normal;
+};
+static_assert(sizeof(Vertex) == 24);
+
+// ---- Constants of engine/ShaderCompat.h ------------------------------------------------------------
+
+inline constexpr uint32_t MAX_RAY_RECURSION_DEPTH = 3;
+enum RayType : uint32_t { Radiance = 0, Shadow = 1, RayTypeCount = 2 };
+// TraceRayParameters: InstanceMask = ~0 (only the low 8 bits count), hit-group offset = ray type,
+// geometry stride = ray type count, miss offset = ray type.
+inline constexpr uint32_t kInstanceMask = ~0u;
+inline constexpr vec4 kBackgroundColor{0.6f, 0.7f, 0.9f, 1.0f};
+inline constexpr float kInShadowRadiance = 0.35f;
+
+// The primitiveType of l_aabbCB. It equals the procedural geometry ordinal (§1.5).
+enum class SignedDistancePrimitive : uint32_t { JuliaSets = 0, IntersectedRoundCube = 1, Mandelbulb = 2 };
+
+// ---- Root signatures (§1.6) ------------------------------------------------------------------------
+
+enum GlobalRootParameter : uint32_t {
+    kOutputView = 0,             // table {UAV u0}: RWTexture2D<float4> g_renderTarget
+    kAccelerationStructure = 1,  // root SRV t0: g_scene
+    kSceneConstantBuffer = 2,    // root CBV b0: g_sceneCB
+    kInstanceBuffer = 3,         // root SRV t3: g_instanceBuffer (4 elements)
+    kVertexBuffers = 4,          // table {SRV t1, t2}: g_indices (raw), g_vertices (structured)
+};
+// Local "Triangle": [0] l_materialCB. Local "Procedural": [0] l_materialCB, [1] l_aabbCB.
+enum LocalRootParameter : uint32_t {
+    kMaterialConstantBuffer = 0,  // 12 constants at b1
+    kAABBConstantBuffer = 1,      // 2 constants at b2 ("Procedural" only)
+};
+
+dxr::RootSignatureDesc globalRootSignatureDesc();
+dxr::RootSignatureDesc triangleLocalRootSignatureDesc();    // named "Triangle"
+dxr::RootSignatureDesc proceduralLocalRootSignatureDesc();  // named "Procedural"
+
+// The eight hit groups of MandelJuliaPacSceneBuilder::BuildHitGroups (the table of §1.5 uses them).
+std::vector<dxr::HitGroupDesc> procedurayHitGroups();
+
+// ---- The shader library ----------------------------------------------------------------------------
+
+// Exports, with their HLSL names: Raygen, Miss, Miss_Shadow, ClosestHit_Triangle, Intersection_Julia,
+// ClosestHit_Julia, Intersection_Pacman, ClosestHit_Pacman, Intersection_Mandelbulb, ClosestHit_Mandelbulb.
+std::shared_ptr<dxr::ShaderLibrary> makeProcedurayShaderLibrary();
+
+// ---- The slab's index and vertex buffers (§1.1) ----------------------------------------------------
+// What the scene uploads as g_indices (36 16-bit indices = 18 dwords) and g_vertices (8 vertices).
+// PORT: ClosestHit_Triangle reads these copies instead of the buffers bound through global parameter 4,
+// because ShaderContext offers no way to read a buffer SRV through a descriptor table.
+extern const std::array<uint16_t, 36> kSlabIndices;
+extern const std::array<Vertex, 8> kSlabVertices;
+
+// ---- Pure helpers of the entry points, exposed for tests -------------------------------------------
+
+// RaytracingShaderHelper.hlsli Load3x16BitIndices: the three 16-bit indices at byte `offsetBytes`,
+// read as two aligned dwords the way a ByteAddressBuffer Load2 does. Dwords past `sizeInBytes` read 0.
+uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t sizeInBytes);
+
+// FresnelReflectanceSchlick(I, N, f0) = f0 + (1 - f0)·pow(1 - saturate(dot(-I, N)), 5).
+vec3 FresnelReflectanceSchlick(vec3 I, vec3 N, vec3 f0);
+
+// JuliaSets.hlsli colorSurface(pos, tn): the iteration-count palette (tn.y = n).
+vec3 colorSurface(vec3 pos, vec2 tn);
+
+// GenerateCameraRay: pixel centre, y flipped, unprojected with mul(float4(s, 0, 1), projectionToWorld).
+// Writes the ray's origin (cameraPosition) and normalised direction.
+void GenerateCameraRay(uvec2 index, uvec2 dimensions, vec3 cameraPosition, const Float4x4& projectionToWorld,
+                       vec3& origin, vec3& direction);
+
+// ClosestHit_Mandelbulb's own lighting (no scene light): the colour before the reflection is added.
+// D = WorldRayDirection(), N = attr.normal, trap = attr.color.
+vec4 MandelbulbSurfaceColor(vec3 D, vec3 N, vec4 trap);
+
+// mul(v, M) for a row vector, summed in row order.
+vec4 mul(const vec4& v, const Float4x4& M);
+
+}  // namespace refray::procedural::proceduray
