@@ -35,11 +35,6 @@ std::string hexOf(uint64_t v) {
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
-std::string valueOf(const Diagnostic& d, const std::string& name) {
-    for (const auto& v : d.values)
-        if (v.name == name) return v.value;
-    return "<no value '" + name + "'>";
-}
 
 #define EXPECT_MESSAGE_HAS(diagnostic, text) \
     EXPECT_TRUE(contains((diagnostic).format(), text)) << "missing '" << (text) << "' in: " << (diagnostic).format()
@@ -68,13 +63,7 @@ public:
         });
         h.library->addClosestHit<Probe, BuiltInTriangleIntersectionAttributes>(
             "CH_Record", [this](ShaderContext& ctx, Probe& p, const BuiltInTriangleIntersectionAttributes& a) {
-                p.closestHits++;
-                p.t = ctx.RayTCurrent();
-                p.hitKind = ctx.HitKind();
-                p.instanceIndex = ctx.InstanceIndex();
-                p.instanceID = ctx.InstanceID();
-                p.geometryIndex = ctx.GeometryIndex();
-                p.primitiveIndex = ctx.PrimitiveIndex();
+                recordHitValues(ctx, p);
                 p.barycentrics = a.barycentrics;
                 p.tag = 77;
                 const uint32_t i = ctx.DispatchRaysIndex().x;

@@ -46,27 +46,8 @@ struct OtherAttributes {
 bool sameBits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 bool sameBits(vec3 a, vec3 b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
-std::string valueOf(const Diagnostic& d, const std::string& name) {
-    for (const auto& v : d.values)
-        if (v.name == name) return v.value;
-    return "<no value '" + name + "'>";
-}
-std::string limitOf(const Diagnostic& d, const std::string& name) {
-    for (const auto& v : d.values)
-        if (v.name == name) return v.limit;
-    return "<no value '" + name + "'>";
-}
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
-void recordHitValues(ShaderContext& ctx, Probe& p) {
-    p.closestHits++;
-    p.t = ctx.RayTCurrent();
-    p.hitKind = ctx.HitKind();
-    p.instanceIndex = ctx.InstanceIndex();
-    p.instanceID = ctx.InstanceID();
-    p.geometryIndex = ctx.GeometryIndex();
-    p.primitiveIndex = ctx.PrimitiveIndex();
-}
 
 // A harness with scriptable shaders. Every script is optional; the defaults record like
 // the harness probes. Hit groups:

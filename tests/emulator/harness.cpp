@@ -46,8 +46,7 @@ InstanceDesc Harness::instance(GpuVirtualAddress blas, uint32_t contribution, co
     return makeInstanceDesc(transform, instanceID, mask, contribution, flags, blas);
 }
 
-namespace {
-void recordHit(ShaderContext& ctx, Probe& p) {
+void recordHitValues(ShaderContext& ctx, Probe& p) {
     p.closestHits++;
     p.t = ctx.RayTCurrent();
     p.hitKind = ctx.HitKind();
@@ -56,16 +55,31 @@ void recordHit(ShaderContext& ctx, Probe& p) {
     p.geometryIndex = ctx.GeometryIndex();
     p.primitiveIndex = ctx.PrimitiveIndex();
 }
-}  // namespace
+
+const DiagnosticValue* findValue(const Diagnostic& d, const std::string& name) {
+    for (const auto& v : d.values)
+        if (v.name == name) return &v;
+    return nullptr;
+}
+
+std::string valueOf(const Diagnostic& d, const std::string& name) {
+    const DiagnosticValue* v = findValue(d, name);
+    return v ? v->value : "<no value '" + name + "'>";
+}
+
+std::string limitOf(const Diagnostic& d, const std::string& name) {
+    const DiagnosticValue* v = findValue(d, name);
+    return v ? v->limit : "<no value '" + name + "'>";
+}
 
 void Harness::addProbeShaders() {
     library->addClosestHit<Probe, BuiltInTriangleIntersectionAttributes>(
         "CH_Probe", [](ShaderContext& ctx, Probe& p, const BuiltInTriangleIntersectionAttributes& a) {
-            recordHit(ctx, p);
+            recordHitValues(ctx, p);
             p.barycentrics = a.barycentrics;
         });
     library->addClosestHit<Probe, ProbeAttributes>("CH_ProbeAABB", [](ShaderContext& ctx, Probe& p, const ProbeAttributes&) {
-        recordHit(ctx, p);
+        recordHitValues(ctx, p);
     });
     library->addAnyHit<Probe, BuiltInTriangleIntersectionAttributes>(
         "AH_Probe", [](ShaderContext&, Probe& p, const BuiltInTriangleIntersectionAttributes&) { p.anyHits++; });

@@ -86,6 +86,14 @@ public:
     GpuVirtualAddress scene = 0;
 };
 
+// The value (or limit) a diagnostic gives for `name`, or "<no value 'name'>".
+const DiagnosticValue* findValue(const Diagnostic& d, const std::string& name);
+std::string valueOf(const Diagnostic& d, const std::string& name);
+std::string limitOf(const Diagnostic& d, const std::string& name);
+
+// What CH_Probe records: closestHits++, t, HitKind and the index system values.
+void recordHitValues(ShaderContext& ctx, Probe& p);
+
 // Runs `fn` expecting a DxrError with `ruleId`; returns its diagnostic (fails the test otherwise).
 Diagnostic expectDxrError(const std::string& ruleId, const std::function<void()>& fn);
 

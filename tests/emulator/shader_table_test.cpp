@@ -15,16 +15,6 @@ namespace {
 // ---------------------------------------------------------------------------------------
 // Helpers: shaders whose record is identified by a local root constant (the "tag").
 
-const DiagnosticValue* findValue(const Diagnostic& d, const std::string& name) {
-    for (const auto& v : d.values)
-        if (v.name == name) return &v;
-    return nullptr;
-}
-
-std::string valueOf(const Diagnostic& d, const std::string& name) {
-    const DiagnosticValue* v = findValue(d, name);
-    return v ? v->value : "(absent: " + name + ")";
-}
 
 RootSignaturePtr tagSignature(const std::string& name = "Tag") {
     return RootSignature::create({name, {RootParameter::constants(1, 0)}, ROOT_SIGNATURE_FLAG_LOCAL_ROOT_SIGNATURE});

@@ -11,16 +11,6 @@
 namespace refray::test {
 namespace {
 
-const DiagnosticValue* findValue(const Diagnostic& d, const std::string& name) {
-    for (const auto& v : d.values)
-        if (v.name == name) return &v;
-    return nullptr;
-}
-
-std::string valueOf(const Diagnostic& d, const std::string& name) {
-    const DiagnosticValue* v = findValue(d, name);
-    return v ? v->value : "(absent: " + name + ")";
-}
 
 // Runs `fn` expecting a refray::Error (any kind); returns its message.
 std::string expectError(const std::function<void()>& fn) {
