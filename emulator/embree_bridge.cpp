@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <mutex>
 
 #include <embree3/rtcore.h>
@@ -63,6 +64,7 @@ namespace {
 struct GatherContext {
     RTCIntersectContext embree;  // must be first
     const GatherRequest* request;
+    std::exception_ptr error;  // the first exception a callback caught (style rule 9)
 };
 
 // Enlarge bounds by a relative margin so Embree's float traversal never culls a box
@@ -104,10 +106,23 @@ void boundsCallback(const RTCBoundsFunctionArguments* args) {
     enlarge(b);
 }
 
+void gatherPrimitive(const RTCIntersectFunctionNArguments* args, const GatherRequest& req);
+
+// Embree swallows exceptions, so the callback catches everything, stops the traversal
+// and leaves the error for gatherCandidates to rethrow once rtcIntersect1 has returned.
 void intersectCallback(const RTCIntersectFunctionNArguments* args) {
     if (!args->valid[0]) return;
-    const auto* ctx = reinterpret_cast<const GatherContext*>(args->context);
-    const GatherRequest& req = *ctx->request;
+    auto* ctx = reinterpret_cast<GatherContext*>(args->context);
+    if (ctx->error) return;
+    try {
+        gatherPrimitive(args, *ctx->request);
+    } catch (...) {
+        ctx->error = std::current_exception();
+        RTCRayN_tfar(RTCRayHitN_RayN(args->rayhit, args->N), args->N, 0) = -INFINITY;
+    }
+}
+
+void gatherPrimitive(const RTCIntersectFunctionNArguments* args, const GatherRequest& req) {
     const auto* user = static_cast<const UserGeometry*>(args->geometryUserPtr);
     const BuiltGeometry& g = *user->geometry;
     const uint32_t prim = args->primID;
@@ -219,7 +234,9 @@ void gatherCandidates(const GatherRequest& request) {
     rayhit.ray.flags = 0;
     rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    ctx.error = nullptr;
     rtcIntersect1(static_cast<RTCScene>(request.tlas->embree().scene), &ctx.embree, &rayhit);
+    if (ctx.error) std::rethrow_exception(ctx.error);
 }
 
 }  // namespace refray::dxr::detail
