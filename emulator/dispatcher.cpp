@@ -903,6 +903,20 @@ Image& ShaderContext::rwTexture2D(GpuDescriptorHandle tableHandle, uint32_t offs
     return *d.texture;
 }
 
+void ShaderContext::readBufferView(GpuDescriptorHandle tableHandle, uint32_t offset, uint64_t byteOffset, uint64_t size,
+                                   void* out) const {
+    const DescriptorHeap* heap = inv_.dispatch->device->findDescriptorHeap(tableHandle);
+    if (!heap) stageError(inv_, "GEN-1", "descriptor handle is not in any descriptor heap");
+    const Descriptor& d = heap->at(tableHandle, offset);
+    if (d.kind != Descriptor::Kind::Buffer)
+        stageError(inv_, "GEN-1", "descriptor " + std::to_string(offset) + " of heap '" + heap->name() +
+                                      "' is not a buffer view");
+    std::memset(out, 0, size);
+    if (byteOffset >= d.buffer.sizeInBytes) return;  // wholly out of range: zeros
+    const uint64_t inRange = std::min(size, d.buffer.sizeInBytes - byteOffset);
+    std::memcpy(out, readMemory(d.buffer.address + byteOffset, inRange), inRange);
+}
+
 // ---------------------------------------------------------------------------------------
 // DispatchRays.
 

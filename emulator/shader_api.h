@@ -117,6 +117,15 @@ public:
     }
     // RWTexture2D<float4> bound as descriptor `offset` of the table at `tableHandle`.
     Image& rwTexture2D(GpuDescriptorHandle tableHandle, uint32_t offset = 0) const;
+    // A T at `byteOffset` in the buffer bound as descriptor `offset` of the table at
+    // `tableHandle` (ByteAddressBuffer.Load, StructuredBuffer[i] with byteOffset = i * stride).
+    // Reads past the view's end return zeros, as D3D defines for buffer views.
+    template <class T>
+    T loadFromTable(GpuDescriptorHandle tableHandle, uint32_t offset, uint64_t byteOffset) const {
+        T value;
+        readBufferView(tableHandle, offset, byteOffset, sizeof(T), &value);
+        return value;
+    }
 
 private:
     // Stage masks for SV-1.
@@ -144,6 +153,8 @@ private:
     void callShader(uint32_t index, void* parameters, TypeTag type);
     const uint8_t* rootArgument(bool local, uint32_t parameter, size_t size, TypeTag type) const;
     const uint8_t* readMemory(GpuVirtualAddress address, uint64_t size) const;
+    void readBufferView(GpuDescriptorHandle tableHandle, uint32_t offset, uint64_t byteOffset, uint64_t size,
+                        void* out) const;
 
     detail::Invocation& inv_;
 };

@@ -123,3 +123,37 @@ TEST(RootSignature, REC_6_LocalDescriptorTableTakesAFullEightByteHandle) {
 }
 
 }  // namespace refray::test
+
+namespace refray::test {
+
+TEST(ShaderApi, BufferViewsInADescriptorTableReadZeroPastTheirEnd) {
+    Harness h;
+    const std::vector<uint32_t> data = {11, 22, 33};
+    DescriptorHeap& heap = h.device.createDescriptorHeap(2, "buffers");
+    heap.setBuffer(1, DescriptorRangeType::SRV, {h.device.memory().upload(data, "data"), 12, 4});
+    std::vector<uint32_t> seen;
+    h.library->addRayGeneration("RG", [&](ShaderContext& ctx) {
+        const GpuDescriptorHandle table = heap.gpuHandle(0);
+        for (uint64_t i = 0; i < 4; ++i) seen.push_back(ctx.loadFromTable<uint32_t>(table, 1, 4 * i));
+        const uint64_t straddling = ctx.loadFromTable<uint64_t>(table, 1, 8);  // 4 bytes in range, 4 past
+        seen.push_back(uint32_t(straddling >> 32));
+    });
+    h.stateObject.pipelineConfigs = {{0, 0}};
+    const auto so = h.pipeline();
+    h.dispatch(so, {}, {});
+    EXPECT_EQ(seen, (std::vector<uint32_t>{11, 22, 33, 0, 0}));
+}
+
+TEST(ShaderApi, ReadingATextureDescriptorAsABufferIsAnError) {
+    Harness h;
+    Image image(1, 1);
+    DescriptorHeap& heap = h.device.createDescriptorHeap(1, "textures");
+    heap.setTexture2D(0, DescriptorRangeType::UAV, &image);
+    h.library->addRayGeneration("RG", [&](ShaderContext& ctx) { ctx.loadFromTable<uint32_t>(heap.gpuHandle(0), 0, 0); });
+    h.stateObject.pipelineConfigs = {{0, 0}};
+    const auto so = h.pipeline();
+    const Diagnostic d = expectDxrError("GEN-1", [&] { h.dispatch(so, {}, {}); });
+    EXPECT_NE(d.message.find("is not a buffer view"), std::string::npos) << d.message;
+}
+
+}  // namespace refray::test
