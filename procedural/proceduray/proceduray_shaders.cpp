@@ -78,18 +78,20 @@ std::vector<HitGroupDesc> procedurayHitGroups() {
 
 // ---- Pure helpers ----------------------------------------------------------------------------------
 
-vec4 mul(const vec4& v, const Float4x4& M) {
-    vec4 r;
-    for (int j = 0; j < 4; ++j) r[j] = v.x * M.m[0][j] + v.y * M.m[1][j] + v.z * M.m[2][j] + v.w * M.m[3][j];
-    return r;
-}
-
 namespace {
 
+template <typename T>
+using tvec2 = math::vec2<T>;
+template <typename T>
+using tvec3 = math::vec3<T>;
+template <typename T>
+using tvec4 = math::vec4<T>;
+
 // mul(v, (float3x3)M): the upper-left 3x3 of a row-major matrix, row vector on the left.
-vec3 mul3x3(const vec3& v, const Float4x4& M) {
-    vec3 r;
-    for (int j = 0; j < 3; ++j) r[j] = v.x * M.m[0][j] + v.y * M.m[1][j] + v.z * M.m[2][j];
+template <typename T>
+tvec3<T> mul3x3(const tvec3<T>& v, const Float4x4& M) {
+    tvec3<T> r;
+    for (int j = 0; j < 3; ++j) r[j] = v.x * T(M.m[0][j]) + v.y * T(M.m[1][j]) + v.z * T(M.m[2][j]);
     return r;
 }
 
@@ -101,6 +103,14 @@ uint32_t loadDword(const uint8_t* data, size_t sizeInBytes, uint32_t offset) {
 }
 
 }  // namespace
+
+template <typename T>
+tvec4<T> mul(const tvec4<T>& v, const Float4x4& M) {
+    tvec4<T> r;
+    for (int j = 0; j < 4; ++j)
+        r[j] = v.x * T(M.m[0][j]) + v.y * T(M.m[1][j]) + v.z * T(M.m[2][j]) + v.w * T(M.m[3][j]);
+    return r;
+}
 
 uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t sizeInBytes) {
     const uint32_t dwordAlignedOffset = offsetBytes & ~3u;
@@ -119,73 +129,94 @@ uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t si
     return result;
 }
 
-vec3 FresnelReflectanceSchlick(vec3 I, vec3 N, vec3 f0) {
-    const float cosi = hlsl::saturate(hlsl::dot(-I, N));
-    return f0 + (1.0f - f0) * hlsl::pow(1.0f - cosi, 5.0f);
+template <typename T>
+tvec3<T> FresnelReflectanceSchlick(tvec3<T> I, tvec3<T> N, tvec3<T> f0) {
+    const T cosi = hlsl::saturate(hlsl::dot(-I, N));
+    return f0 + (T(1) - f0) * hlsl::pow(T(1) - cosi, T(5));
 }
 
-vec3 colorSurface(vec3 pos, vec2 tn) {
-    vec3 col = 0.5f + 0.5f * hlsl::cos(hlsl::log2(tn.y) * 0.9f + 3.5f + vec3(0.0f, 0.6f, 1.0f));
-    if (pos.y > 0.0f) col = hlsl::lerp(col, vec3(1.0f), 0.2f);
-    const float inside = hlsl::smoothstep(14.0f, 15.0f, tn.y);
-    col *= vec3(0.45f, 0.42f, 0.40f) + vec3(0.55f, 0.58f, 0.60f) * inside;
-    col = hlsl::lerp(col * col * (3.0f - 2.0f * col), col, inside);
-    col = hlsl::lerp(hlsl::lerp(col, vec3(hlsl::dot(col, vec3(0.3333f, 0.333f, 0.333f))), -0.4f), col, inside);
-    return hlsl::clamp(col * 0.65f, 0.0f, 1.0f);
+template <typename T>
+tvec3<T> colorSurface(tvec3<T> pos, tvec2<T> tn) {
+    tvec3<T> col = T(0.5f) + T(0.5f) * hlsl::cos(hlsl::log2(tn.y) * T(0.9f) + T(3.5f) + tvec3<T>(0.0f, 0.6f, 1.0f));
+    if (pos.y > T(0)) col = hlsl::lerp(col, tvec3<T>(T(1)), T(0.2f));
+    const T inside = hlsl::smoothstep(T(14), T(15), tn.y);
+    col *= tvec3<T>(0.45f, 0.42f, 0.40f) + tvec3<T>(0.55f, 0.58f, 0.60f) * inside;
+    col = hlsl::lerp(col * col * (T(3) - T(2) * col), col, inside);
+    col = hlsl::lerp(hlsl::lerp(col, tvec3<T>(hlsl::dot(col, tvec3<T>(0.3333f, 0.333f, 0.333f))), T(-0.4f)), col,
+                     inside);
+    return hlsl::clamp(col * T(0.65f), T(0), T(1));
 }
 
-void GenerateCameraRay(uvec2 index, uvec2 dimensions, vec3 cameraPosition, const Float4x4& projectionToWorld,
-                       vec3& origin, vec3& direction) {
-    const vec2 xy = vec2(index) + 0.5f;
-    vec2 screenPos = xy / vec2(dimensions) * 2.0f - 1.0f;
+template <typename T>
+void GenerateCameraRay(uvec2 index, uvec2 dimensions, tvec3<T> cameraPosition, const Float4x4& projectionToWorld,
+                       tvec3<T>& origin, tvec3<T>& direction) {
+    const tvec2<T> xy = tvec2<T>(index) + T(0.5f);
+    tvec2<T> screenPos = xy / tvec2<T>(dimensions) * T(2) - T(1);
     screenPos.y = -screenPos.y;
-    vec4 world = mul(vec4(screenPos, 0.0f, 1.0f), projectionToWorld);
-    const vec3 worldXYZ = vec3(world) / world.w;
+    const tvec4<T> world = mul(tvec4<T>(screenPos, T(0), T(1)), projectionToWorld);
+    const tvec3<T> worldXYZ = tvec3<T>(world) / world.w;
     origin = cameraPosition;
     direction = hlsl::normalize(worldXYZ - origin);
 }
 
-vec4 MandelbulbSurfaceColor(vec3 D, vec3 N, vec4 trap) {
+template <typename T>
+tvec4<T> MandelbulbSurfaceColor(tvec3<T> D, tvec3<T> N, tvec4<T> trap) {
     // Colour from the orbit trap.
-    vec3 col(0.01f, 0.01f, 0.01f);
-    col = hlsl::lerp(col, vec3(0.10f, 0.20f, 0.30f), hlsl::clamp(trap.y, 0.0f, 1.0f));
-    col = hlsl::lerp(col, vec3(0.02f, 0.10f, 0.30f), hlsl::clamp(trap.z * trap.z, 0.0f, 1.0f));
-    col = hlsl::lerp(col, vec3(0.30f, 0.10f, 0.02f), hlsl::clamp(hlsl::pow(trap.w, 6.0f), 0.0f, 1.0f));
-    col *= 0.5f;
+    tvec3<T> col(0.01f, 0.01f, 0.01f);
+    col = hlsl::lerp(col, tvec3<T>(0.10f, 0.20f, 0.30f), hlsl::clamp(trap.y, T(0), T(1)));
+    col = hlsl::lerp(col, tvec3<T>(0.02f, 0.10f, 0.30f), hlsl::clamp(trap.z * trap.z, T(0), T(1)));
+    col = hlsl::lerp(col, tvec3<T>(0.30f, 0.10f, 0.02f), hlsl::clamp(hlsl::pow(trap.w, T(6)), T(0), T(1)));
+    col *= T(0.5f);
 
     // Lighting terms: two fixed lights, no scene light, no shadow (sha1 = 1).
-    const vec3 light1(0.577f, 0.577f, -0.577f);
-    const vec3 light2(-0.707f, 0.000f, 0.707f);
-    const vec3 nor = N;
-    const vec3 hal = hlsl::normalize(light1 - D);
-    const float occ = hlsl::clamp(0.05f * hlsl::log(trap.x), 0.0f, 1.0f);
-    const float fac = hlsl::clamp(1.0f + hlsl::dot(D, nor), 0.0f, 1.0f);
+    const tvec3<T> light1(0.577f, 0.577f, -0.577f);
+    const tvec3<T> light2(-0.707f, 0.000f, 0.707f);
+    const tvec3<T> nor = N;
+    const tvec3<T> hal = hlsl::normalize(light1 - D);
+    const T occ = hlsl::clamp(T(0.05f) * hlsl::log(trap.x), T(0), T(1));
+    const T fac = hlsl::clamp(T(1) + hlsl::dot(D, nor), T(0), T(1));
 
-    const float sha1 = 1.0f;
-    const float dif1 = hlsl::clamp(hlsl::dot(light1, nor), 0.0f, 1.0f) * sha1;
-    const float spe1 = hlsl::pow(hlsl::clamp(hlsl::dot(nor, hal), 0.0f, 1.0f), 32.0f) * dif1 *
-                       (0.04f + 0.96f * hlsl::pow(hlsl::clamp(1.0f - hlsl::dot(hal, light1), 0.0f, 1.0f), 5.0f));
-    const float dif2 = hlsl::clamp(0.5f + 0.5f * hlsl::dot(light2, nor), 0.0f, 1.0f) * occ;
-    const float dif3 = (0.7f + 0.3f * nor.y) * (0.2f + 0.8f * occ);
+    const T sha1 = T(1);
+    const T dif1 = hlsl::clamp(hlsl::dot(light1, nor), T(0), T(1)) * sha1;
+    const T spe1 = hlsl::pow(hlsl::clamp(hlsl::dot(nor, hal), T(0), T(1)), T(32)) * dif1 *
+                   (T(0.04f) + T(0.96f) * hlsl::pow(hlsl::clamp(T(1) - hlsl::dot(hal, light1), T(0), T(1)), T(5)));
+    const T dif2 = hlsl::clamp(T(0.5f) + T(0.5f) * hlsl::dot(light2, nor), T(0), T(1)) * occ;
+    const T dif3 = (T(0.7f) + T(0.3f) * nor.y) * (T(0.2f) + T(0.8f) * occ);
 
-    vec3 lin(0.0f);
-    lin += 7.0f * vec3(1.50f, 1.10f, 0.70f) * dif1;
-    lin += 4.0f * vec3(0.25f, 0.20f, 0.15f) * dif2;
-    lin += 1.5f * vec3(0.10f, 0.20f, 0.30f) * dif3;
-    lin += 2.5f * vec3(0.35f, 0.30f, 0.25f) * (0.05f + 0.95f * occ);
-    lin += 4.0f * fac * occ;
+    tvec3<T> lin(T(0));
+    lin += T(7) * tvec3<T>(1.50f, 1.10f, 0.70f) * dif1;
+    lin += T(4) * tvec3<T>(0.25f, 0.20f, 0.15f) * dif2;
+    lin += T(1.5f) * tvec3<T>(0.10f, 0.20f, 0.30f) * dif3;
+    lin += T(2.5f) * tvec3<T>(0.35f, 0.30f, 0.25f) * (T(0.05f) + T(0.95f) * occ);
+    lin += T(4) * fac * occ;
     col *= lin;
-    col = hlsl::pow(col, vec3(0.7f, 0.9f, 1.0f));
-    col += spe1 * 15.0f;
+    col = hlsl::pow(col, tvec3<T>(0.7f, 0.9f, 1.0f));
+    col += spe1 * T(15);
     col = hlsl::sqrt(col);
-    return vec4(col, 1.0f);
+    return tvec4<T>(col, T(1));
 }
+
+#define REFRAY_INSTANTIATE_HELPERS(T)                                                                   \
+    template tvec3<T> FresnelReflectanceSchlick<T>(tvec3<T>, tvec3<T>, tvec3<T>);                      \
+    template tvec3<T> colorSurface<T>(tvec3<T>, tvec2<T>);                                              \
+    template void GenerateCameraRay<T>(uvec2, uvec2, tvec3<T>, const Float4x4&, tvec3<T>&, tvec3<T>&); \
+    template tvec4<T> MandelbulbSurfaceColor<T>(tvec3<T>, tvec3<T>, tvec4<T>);                          \
+    template tvec4<T> mul<T>(const tvec4<T>&, const Float4x4&);
+REFRAY_INSTANTIATE_HELPERS(float)
+REFRAY_INSTANTIATE_HELPERS(double)
+#undef REFRAY_INSTANTIATE_HELPERS
 
 // ---- Shader-side helpers (Helpers.hlsli, RaytracingShaderHelper.hlsli) -----------------------------
 
 namespace {
 
-using hlsl::ScopedFlushDenormals;
+// Float mode runs with denormals flushed (H18); the double oracle keeps them.
+template <typename T>
+struct PrecisionScope {};
+template <>
+struct PrecisionScope<float> {
+    hlsl::ScopedFlushDenormals ftz;
+};
 
 SceneConstantBuffer sceneCB(const ShaderContext& ctx) {
     return ctx.load<SceneConstantBuffer>(ctx.globalRootDescriptor(kSceneConstantBuffer));
@@ -199,93 +230,104 @@ PrimitiveInstanceConstantBuffer aabbCB(const ShaderContext& ctx) {
     return ctx.localRootConstants<PrimitiveInstanceConstantBuffer>(kAABBConstantBuffer);
 }
 
-vec3 HitWorldPosition(const ShaderContext& ctx) {
-    return ctx.WorldRayOrigin() + ctx.RayTCurrent() * ctx.WorldRayDirection();
+template <typename T>
+tvec3<T> HitWorldPosition(const ShaderContext& ctx) {
+    return tvec3<T>(ctx.WorldRayOrigin()) + T(ctx.RayTCurrent()) * tvec3<T>(ctx.WorldRayDirection());
 }
 
 // The world ray in the AABB's local space through g_instanceBuffer[l_aabbCB.instanceIndex]; the
 // direction is normalised, which is where H1 comes from.
-math::Ray<float> GetRayInAABBPrimitiveLocalSpace(const ShaderContext& ctx) {
+template <typename T>
+math::Ray<T> GetRayInAABBPrimitiveLocalSpace(const ShaderContext& ctx) {
     const GpuVirtualAddress element =
         ctx.globalRootDescriptor(kInstanceBuffer) + uint64_t(aabbCB(ctx).instanceIndex) * sizeof(InstanceBuffer);
     const InstanceBuffer attr = ctx.load<InstanceBuffer>(element);
-    math::Ray<float> ray;
-    ray.origin = vec3(mul(vec4(ctx.WorldRayOrigin(), 1.0f), attr.localSpaceToBottomLevelAS));
-    ray.direction = hlsl::normalize(mul3x3(ctx.WorldRayDirection(), attr.localSpaceToBottomLevelAS));
+    math::Ray<T> ray;
+    ray.origin = tvec3<T>(mul(tvec4<T>(tvec3<T>(ctx.WorldRayOrigin()), T(1)), attr.localSpaceToBottomLevelAS));
+    ray.direction = hlsl::normalize(mul3x3(tvec3<T>(ctx.WorldRayDirection()), attr.localSpaceToBottomLevelAS));
     return ray;
 }
 
 // normalize(mul(n, (float3x3)WorldToObject3x4())): the inverse transpose of ObjectToWorld.
-vec3 NormalToWorld(const ShaderContext& ctx, const vec3& n) {
+template <typename T>
+tvec3<T> NormalToWorld(const ShaderContext& ctx, const tvec3<T>& n) {
     const Matrix3x4 w = ctx.WorldToObject3x4();
-    vec3 r;
-    for (int j = 0; j < 3; ++j) r[j] = n.x * w.m[0][j] + n.y * w.m[1][j] + n.z * w.m[2][j];
+    tvec3<T> r;
+    for (int j = 0; j < 3; ++j) r[j] = n.x * T(w.m[0][j]) + n.y * T(w.m[1][j]) + n.z * T(w.m[2][j]);
     return hlsl::normalize(r);
 }
 
-math::RayExtent<float> CurrentExtent(const ShaderContext& ctx) {
+template <typename T>
+math::RayExtent<T> CurrentExtent(const ShaderContext& ctx) {
     const uint32_t flags = ctx.RayFlags();
-    return {ctx.RayTMin(), ctx.RayTCurrent(), (flags & RAY_FLAG_CULL_BACK_FACING_TRIANGLES) != 0,
+    return {T(ctx.RayTMin()), T(ctx.RayTCurrent()), (flags & RAY_FLAG_CULL_BACK_FACING_TRIANGLES) != 0,
             (flags & RAY_FLAG_CULL_FRONT_FACING_TRIANGLES) != 0};
 }
 
-float CalculateDiffuseCoefficient(const vec3& incidentLightRay, const vec3& normal) {
+template <typename T>
+T CalculateDiffuseCoefficient(const tvec3<T>& incidentLightRay, const tvec3<T>& normal) {
     return hlsl::saturate(hlsl::dot(-incidentLightRay, normal));
 }
 
-float CalculateSpecularCoefficient(const ShaderContext& ctx, const vec3& incidentLightRay, const vec3& normal,
-                                   float specularPower) {
-    const vec3 reflectedLightRay = hlsl::normalize(hlsl::reflect(incidentLightRay, normal));
-    return hlsl::pow(hlsl::saturate(hlsl::dot(reflectedLightRay, hlsl::normalize(-ctx.WorldRayDirection()))),
+template <typename T>
+T CalculateSpecularCoefficient(const ShaderContext& ctx, const tvec3<T>& incidentLightRay, const tvec3<T>& normal,
+                               T specularPower) {
+    const tvec3<T> reflectedLightRay = hlsl::normalize(hlsl::reflect(incidentLightRay, normal));
+    return hlsl::pow(hlsl::saturate(hlsl::dot(reflectedLightRay, hlsl::normalize(-tvec3<T>(ctx.WorldRayDirection())))),
                      specularPower);
 }
 
 // Phong = ambient (with the "fake AO" towards -y) + diffuse + specular; the light is a point light.
-vec4 CalculatePhongLighting(const ShaderContext& ctx, const SceneConstantBuffer& g_sceneCB, const vec4& albedo,
-                            const vec3& normal, bool isInShadow, float diffuseCoef, float specularCoef,
-                            float specularPower) {
-    const vec3 hitPosition = HitWorldPosition(ctx);
-    const vec3 lightPosition = vec3(g_sceneCB.lightPosition);
-    const float shadowFactor = isInShadow ? kInShadowRadiance : 1.0f;
-    const vec3 incidentLightRay = hlsl::normalize(hitPosition - lightPosition);
+template <typename T>
+tvec4<T> CalculatePhongLighting(const ShaderContext& ctx, const SceneConstantBuffer& g_sceneCB, const tvec4<T>& albedo,
+                                const tvec3<T>& normal, bool isInShadow, T diffuseCoef, T specularCoef,
+                                T specularPower) {
+    const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
+    const tvec3<T> lightPosition = tvec3<T>(g_sceneCB.lightPosition);
+    const T shadowFactor = isInShadow ? T(kInShadowRadiance) : T(1);
+    const tvec3<T> incidentLightRay = hlsl::normalize(hitPosition - lightPosition);
 
     // Diffuse component.
-    const vec4 lightDiffuseColor = g_sceneCB.lightDiffuseColor;
-    const float Kd = CalculateDiffuseCoefficient(incidentLightRay, normal);
-    const vec4 diffuseColor = shadowFactor * diffuseCoef * Kd * lightDiffuseColor * albedo;
+    const tvec4<T> lightDiffuseColor = tvec4<T>(g_sceneCB.lightDiffuseColor);
+    const T Kd = CalculateDiffuseCoefficient(incidentLightRay, normal);
+    const tvec4<T> diffuseColor = shadowFactor * diffuseCoef * Kd * lightDiffuseColor * albedo;
 
     // Specular component.
-    vec4 specularColor(0.0f);
+    tvec4<T> specularColor(T(0));
     if (!isInShadow) {
-        const vec4 lightSpecularColor(1.0f);
-        const float Ks = CalculateSpecularCoefficient(ctx, incidentLightRay, normal, specularPower);
+        const tvec4<T> lightSpecularColor(T(1));
+        const T Ks = CalculateSpecularCoefficient(ctx, incidentLightRay, normal, specularPower);
         specularColor = specularCoef * Ks * lightSpecularColor;
     }
 
     // Ambient component.
-    const vec4 ambientColorMin = g_sceneCB.lightAmbientColor - 0.1f;
-    const vec4 ambientColorMax = g_sceneCB.lightAmbientColor;
-    const float a = 1.0f - hlsl::saturate(hlsl::dot(normal, vec3(0.0f, -1.0f, 0.0f)));
-    const vec4 ambientColor = albedo * hlsl::lerp(ambientColorMin, ambientColorMax, a);
+    const tvec4<T> ambientColorMin = tvec4<T>(g_sceneCB.lightAmbientColor) - T(0.1f);
+    const tvec4<T> ambientColorMax = tvec4<T>(g_sceneCB.lightAmbientColor);
+    const T a = T(1) - hlsl::saturate(hlsl::dot(normal, tvec3<T>(0.0f, -1.0f, 0.0f)));
+    const tvec4<T> ambientColor = albedo * hlsl::lerp(ambientColorMin, ambientColorMax, a);
 
     return ambientColor + diffuseColor + specularColor;
 }
 
 // TraceRay wrappers: both stop at MAX_RAY_RECURSION_DEPTH (black / "not in shadow"); TMin 0, TMax 10000.
-vec4 TraceRadianceRay(ShaderContext& ctx, const vec3& origin, const vec3& direction, uint32_t currentRayRecursionDepth) {
-    if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH) return vec4(0.0f);
-    const RayDesc rayDesc{origin, 0.0f, direction, 10000.0f};
+// The RayDesc and the payload are the GPU interface: the ray is rounded to float on the way in.
+template <typename T>
+tvec4<T> TraceRadianceRay(ShaderContext& ctx, const tvec3<T>& origin, const tvec3<T>& direction,
+                          uint32_t currentRayRecursionDepth) {
+    if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH) return tvec4<T>(T(0));
+    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     RayPayload rayPayload{vec4(0.0f), currentRayRecursionDepth + 1, 0.0f, 0, 0};
     ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_CULL_BACK_FACING_TRIANGLES, kInstanceMask,
                  /*RayContributionToHitGroupIndex*/ Radiance, /*MultiplierForGeometryContribution*/ RayTypeCount,
                  /*MissShaderIndex*/ Radiance, rayDesc, rayPayload);
-    return rayPayload.color;
+    return tvec4<T>(rayPayload.color);
 }
 
-bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const vec3& origin, const vec3& direction,
+template <typename T>
+bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const tvec3<T>& origin, const tvec3<T>& direction,
                                   uint32_t currentRayRecursionDepth) {
     if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH) return false;
-    const RayDesc rayDesc{origin, 0.0f, direction, 10000.0f};
+    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     // Starts as "hit": closest-hit and any-hit shaders are skipped, only Miss_Shadow clears it.
     ShadowRayPayload shadowPayload{0.0f, 1};
     ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure),
@@ -297,46 +339,52 @@ bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const vec3& origin, const 
 }
 
 // The shadow test every lit closest hit starts with: from HitWorldPosition() towards the light.
+template <typename T>
 bool TraceShadowRayTowardsLight(ShaderContext& ctx, const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth) {
-    const vec3 hitPosition = HitWorldPosition(ctx);
-    return TraceShadowRayAndReportIfHit(ctx, hitPosition, hlsl::normalize(vec3(g_sceneCB.lightPosition) - hitPosition),
-                                        recursionDepth);
+    const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
+    return TraceShadowRayAndReportIfHit(
+        ctx, hitPosition, hlsl::normalize(tvec3<T>(g_sceneCB.lightPosition) - hitPosition), recursionDepth);
 }
 
 // reflectanceCoef·(Fresnel, 1)·(reflection ray colour), the reflection ray leaving HitWorldPosition().
-vec4 ReflectedColor(ShaderContext& ctx, const vec3& normal, float reflectanceCoef, const vec3& f0,
-                    uint32_t recursionDepth) {
-    const vec4 reflectionColor =
-        TraceRadianceRay(ctx, HitWorldPosition(ctx), hlsl::reflect(ctx.WorldRayDirection(), normal), recursionDepth);
-    const vec3 fresnelR = FresnelReflectanceSchlick(ctx.WorldRayDirection(), normal, f0);
-    return reflectanceCoef * vec4(fresnelR, 1.0f) * reflectionColor;
+template <typename T>
+tvec4<T> ReflectedColor(ShaderContext& ctx, const tvec3<T>& normal, T reflectanceCoef, const tvec3<T>& f0,
+                        uint32_t recursionDepth) {
+    const tvec3<T> D = tvec3<T>(ctx.WorldRayDirection());
+    const tvec4<T> reflectionColor =
+        TraceRadianceRay(ctx, HitWorldPosition<T>(ctx), hlsl::reflect(D, normal), recursionDepth);
+    const tvec3<T> fresnelR = FresnelReflectanceSchlick(D, normal, f0);
+    return reflectanceCoef * tvec4<T>(fresnelR, T(1)) * reflectionColor;
 }
 
 // ProceduralPrimitivesLibrary.hlsli GetDistanceFromSignedDistancePrimitive: only the Pac-man case is live.
 // PORT: takes the mouth interpolant instead of the time (computed once per IS, see fractals.h).
-float GetDistanceFromSignedDistancePrimitive(const vec3& position, SignedDistancePrimitive signedDistancePrimitive,
-                                             float mouth) {
+template <typename T>
+T GetDistanceFromSignedDistancePrimitive(const tvec3<T>& position, SignedDistancePrimitive signedDistancePrimitive,
+                                         T mouth) {
     switch (signedDistancePrimitive) {
         case SignedDistancePrimitive::IntersectedRoundCube: return math::pacman::pacMan(position, mouth);
-        default: return 0.0f;
+        default: return T(0);
     }
 }
 
 constexpr ProceduralPrimitiveAttributes kInitialAttributes{vec3(0.0f), vec4(0.0f, 0.0f, 0.0f, 1.0f)};
 
 // ---- Entry points ----------------------------------------------------------------------------------
+// Each is a template on the scalar type; results are rounded to float where they cross the interface.
 
+template <typename T>
 void Raygen(ShaderContext& ctx) {
-    ScopedFlushDenormals ftz;
+    [[maybe_unused]] PrecisionScope<T> scope;
     const uvec3 index = ctx.DispatchRaysIndex();
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
-    vec3 origin, direction;
-    GenerateCameraRay(uvec2(index), uvec2(ctx.DispatchRaysDimensions()), vec3(g_sceneCB.cameraPosition),
+    tvec3<T> origin, direction;
+    GenerateCameraRay(uvec2(index), uvec2(ctx.DispatchRaysDimensions()), tvec3<T>(g_sceneCB.cameraPosition),
                       g_sceneCB.projectionToWorld, origin, direction);
     const uint32_t currentRecursionDepth = 0;
-    const vec4 color = TraceRadianceRay(ctx, origin, direction, currentRecursionDepth);
+    const tvec4<T> color = TraceRadianceRay(ctx, origin, direction, currentRecursionDepth);
     // PORT: the texture stores floats; the R8G8B8A8_UNORM conversion happens when the image is written out.
-    ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView)).at(index.x, index.y) = color;
+    ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView)).at(index.x, index.y) = vec4(color);
 }
 
 void Miss(ShaderContext&, RayPayload& rayPayload) {
@@ -350,8 +398,9 @@ void Miss_Shadow(ShaderContext&, ShadowRayPayload& rayPayload) {
     rayPayload.hit = 0;
 }
 
+template <typename T>
 void ClosestHit_Triangle(ShaderContext& ctx, RayPayload& rayPayload, const BuiltInTriangleIntersectionAttributes&) {
-    ScopedFlushDenormals ftz;
+    [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     if (g_sceneCB.debugFlag) {
         rayPayload.color = vec4(0.0f, 0.0f, 1.0f, 0.0f);
@@ -368,27 +417,29 @@ void ClosestHit_Triangle(ShaderContext& ctx, RayPayload& rayPayload, const Built
     const uvec3 indices = Load3x16BitIndices(baseIndex, reinterpret_cast<const uint8_t*>(kSlabIndices.data()),
                                              sizeof(kSlabIndices));
     const vec3 storedNormal = indices[0] < kSlabVertices.size() ? kSlabVertices[indices[0]].normal : vec3(0.0f);
-    const vec3 triangleNormal = -storedNormal;
+    const tvec3<T> triangleNormal = -tvec3<T>(storedNormal);
 
-    const bool shadowRayHit = TraceShadowRayTowardsLight(ctx, g_sceneCB, rayPayload.recursionDepth);
+    const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, g_sceneCB, rayPayload.recursionDepth);
 
-    vec4 reflectedColor(0.0f);
+    const tvec4<T> albedo = tvec4<T>(l_materialCB.albedo);
+    tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, triangleNormal, l_materialCB.reflectanceCoef, vec3(l_materialCB.albedo),
+        reflectedColor = ReflectedColor(ctx, triangleNormal, T(l_materialCB.reflectanceCoef), tvec3<T>(albedo),
                                         rayPayload.recursionDepth);
 
-    const vec4 phongColor =
-        CalculatePhongLighting(ctx, g_sceneCB, l_materialCB.albedo, triangleNormal, shadowRayHit,
-                               l_materialCB.diffuseCoef, l_materialCB.specularCoef, l_materialCB.specularPower);
-    vec4 color = phongColor + reflectedColor;
-    color += rayPayload.color;
+    const tvec4<T> phongColor =
+        CalculatePhongLighting(ctx, g_sceneCB, albedo, triangleNormal, shadowRayHit, T(l_materialCB.diffuseCoef),
+                               T(l_materialCB.specularCoef), T(l_materialCB.specularPower));
+    tvec4<T> color = phongColor + reflectedColor;
+    color += tvec4<T>(rayPayload.color);
     rayPayload.dist += ctx.RayTCurrent();
-    rayPayload.color = color;
+    rayPayload.color = vec4(color);
 }
 
+template <typename T>
 void Intersection_Pacman(ShaderContext& ctx) {
-    ScopedFlushDenormals ftz;
-    const math::Ray<float> localRay = GetRayInAABBPrimitiveLocalSpace(ctx);
+    [[maybe_unused]] PrecisionScope<T> scope;
+    const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx);
     const auto primitiveType = SignedDistancePrimitive(aabbCB(ctx).primitiveType);
     ProceduralPrimitiveAttributes attr = kInitialAttributes;
 
@@ -398,51 +449,55 @@ void Intersection_Pacman(ShaderContext& ctx) {
         return;
     }
 
-    const float mouth = math::pacman::PacmanMouthInterpolant(g_sceneCB.elapsedTime);
-    math::SphereTraceParams<float> params;
-    params.stepScale = materialCB(ctx).stepScale;
-    const auto sdf = [primitiveType, mouth](const vec3& p) {
+    const T mouth = math::pacman::PacmanMouthInterpolant(T(g_sceneCB.elapsedTime));
+    math::SphereTraceParams<T> params;
+    params.stepScale = T(materialCB(ctx).stepScale);
+    const auto sdf = [primitiveType, mouth](const tvec3<T>& p) {
         return GetDistanceFromSignedDistancePrimitive(p, primitiveType, mouth);
     };
-    const math::SphereTraceResult<float> primitiveTest =
-        math::RaySignedDistancePrimitiveTest(localRay, CurrentExtent(ctx), sdf, params);
+    const math::SphereTraceResult<T> primitiveTest =
+        math::RaySignedDistancePrimitiveTest(localRay, CurrentExtent<T>(ctx), sdf, params);
 
     // H1: thit is in normalised local units, compared with and reported as if it were world t.
-    if (primitiveTest.hit && primitiveTest.thit < ctx.RayTCurrent()) {
-        attr.color = math::pacman::PacmanHitColor(primitiveTest.normal, primitiveTest.position);
-        attr.normal = NormalToWorld(ctx, primitiveTest.normal);
-        ctx.ReportHit(primitiveTest.thit, /*hitKind*/ 0, attr);
+    if (primitiveTest.hit && primitiveTest.thit < T(ctx.RayTCurrent())) {
+        attr.color = vec4(math::pacman::PacmanHitColor(primitiveTest.normal, primitiveTest.position));
+        attr.normal = vec3(NormalToWorld(ctx, primitiveTest.normal));
+        ctx.ReportHit(float(primitiveTest.thit), /*hitKind*/ 0, attr);
     }
 }
 
+template <typename T>
 void ClosestHit_Pacman(ShaderContext& ctx, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
-    ScopedFlushDenormals ftz;
+    [[maybe_unused]] PrecisionScope<T> scope;
     if (ctx.HitKind() == 1) {
         rayPayload.color = vec4(0.0f, 0.0f, 1.0f, 0.0f);
         return;
     }
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
+    const tvec3<T> normal = tvec3<T>(attr.normal);
+    const tvec4<T> albedo = tvec4<T>(l_materialCB.albedo);
 
-    const bool shadowRayHit = TraceShadowRayTowardsLight(ctx, g_sceneCB, rayPayload.recursionDepth);
+    const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, g_sceneCB, rayPayload.recursionDepth);
 
-    vec4 reflectedColor(0.0f);
+    tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, attr.normal, l_materialCB.reflectanceCoef, vec3(l_materialCB.albedo),
+        reflectedColor = ReflectedColor(ctx, normal, T(l_materialCB.reflectanceCoef), tvec3<T>(albedo),
                                         rayPayload.recursionDepth);
 
-    const vec4 phongColor =
-        CalculatePhongLighting(ctx, g_sceneCB, l_materialCB.albedo, attr.normal, shadowRayHit, l_materialCB.diffuseCoef,
-                               l_materialCB.specularCoef, l_materialCB.specularPower);
-    vec4 color = attr.color * (phongColor + reflectedColor);
-    color += rayPayload.color;
+    const tvec4<T> phongColor =
+        CalculatePhongLighting(ctx, g_sceneCB, albedo, normal, shadowRayHit, T(l_materialCB.diffuseCoef),
+                               T(l_materialCB.specularCoef), T(l_materialCB.specularPower));
+    tvec4<T> color = tvec4<T>(attr.color) * (phongColor + reflectedColor);
+    color += tvec4<T>(rayPayload.color);
     rayPayload.dist += ctx.RayTCurrent();
-    rayPayload.color = color;
+    rayPayload.color = vec4(color);
 }
 
+template <typename T>
 void Intersection_Mandelbulb(ShaderContext& ctx) {
-    ScopedFlushDenormals ftz;
-    const math::Ray<float> localRay = GetRayInAABBPrimitiveLocalSpace(ctx);
+    [[maybe_unused]] PrecisionScope<T> scope;
+    const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx);
     ProceduralPrimitiveAttributes attr = kInitialAttributes;
 
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
@@ -454,41 +509,44 @@ void Intersection_Mandelbulb(ShaderContext& ctx) {
     // The step count animates with time and the procedural instance ordinal (not InstanceIndex()).
     // l_materialCB.stepScale is passed by the HLSL but never used, so it is not read here.
     const int iMax =
-        math::mandelbulb::MandelbulbIterationCount(g_sceneCB.elapsedTime, int(aabbCB(ctx).instanceIndex));
-    const math::mandelbulb::MandelbulbHit<float> primitiveTest =
+        math::mandelbulb::MandelbulbIterationCount(T(g_sceneCB.elapsedTime), int(aabbCB(ctx).instanceIndex));
+    const math::mandelbulb::MandelbulbHit<T> primitiveTest =
         math::mandelbulb::MandelbulbDistance(localRay.origin, localRay.direction, iMax);
 
-    if (primitiveTest.hit && primitiveTest.thit < ctx.RayTCurrent()) {
-        attr.color = primitiveTest.color;
-        attr.normal = NormalToWorld(ctx, primitiveTest.normal);
-        ctx.ReportHit(primitiveTest.thit, /*hitKind*/ 0, attr);
+    if (primitiveTest.hit && primitiveTest.thit < T(ctx.RayTCurrent())) {
+        attr.color = vec4(primitiveTest.color);
+        attr.normal = vec3(NormalToWorld(ctx, primitiveTest.normal));
+        ctx.ReportHit(float(primitiveTest.thit), /*hitKind*/ 0, attr);
     }
 }
 
+template <typename T>
 void ClosestHit_Mandelbulb(ShaderContext& ctx, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
-    ScopedFlushDenormals ftz;
+    [[maybe_unused]] PrecisionScope<T> scope;
     if (ctx.HitKind() == 1) {
         rayPayload.color = vec4(0.0f, 1.0f, 0.0f, 0.0f);
         return;
     }
     const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
+    const tvec3<T> normal = tvec3<T>(attr.normal);
 
-    vec4 color = MandelbulbSurfaceColor(ctx.WorldRayDirection(), attr.normal, attr.color);
+    tvec4<T> color = MandelbulbSurfaceColor(tvec3<T>(ctx.WorldRayDirection()), normal, tvec4<T>(attr.color));
 
-    vec4 reflectedColor(0.0f);
+    tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, attr.normal, l_materialCB.reflectanceCoef, vec3(l_materialCB.albedo),
+        reflectedColor = ReflectedColor(ctx, normal, T(l_materialCB.reflectanceCoef), tvec3<T>(vec3(l_materialCB.albedo)),
                                         rayPayload.recursionDepth);
 
     color = color + reflectedColor;
-    color += rayPayload.color;
+    color += tvec4<T>(rayPayload.color);
     rayPayload.dist += ctx.RayTCurrent();
-    rayPayload.color = color;
+    rayPayload.color = vec4(color);
 }
 
+template <typename T>
 void Intersection_Julia(ShaderContext& ctx) {
-    ScopedFlushDenormals ftz;
-    const math::Ray<float> localRay = GetRayInAABBPrimitiveLocalSpace(ctx);
+    [[maybe_unused]] PrecisionScope<T> scope;
+    const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx);
     ProceduralPrimitiveAttributes attr = kInitialAttributes;
 
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
@@ -498,62 +556,86 @@ void Intersection_Julia(ShaderContext& ctx) {
     }
 
     // PORT: JuliaDistance takes no time; the HLSL's cut animation is computed and then ignored (§5.5).
-    const math::julia::JuliaHit<float> primitiveTest = math::julia::JuliaDistance(localRay.origin, localRay.direction);
-    const vec2 thit = primitiveTest.resT;
+    const math::julia::JuliaHit<T> primitiveTest = math::julia::JuliaDistance(localRay.origin, localRay.direction);
+    const tvec2<T> thit = primitiveTest.resT;
 
     // H1: thit.x is in q-space units (0.4 x normalised local units).
-    if (primitiveTest.hit && thit.x < ctx.RayTCurrent()) {
-        attr.normal = NormalToWorld(ctx, primitiveTest.normal);
-        attr.color = vec4(thit, 0.0f, 0.0f);  // (t, iteration count) for ClosestHit_Julia
-        ctx.ReportHit(thit.x, /*hitKind*/ 0, attr);
+    if (primitiveTest.hit && thit.x < T(ctx.RayTCurrent())) {
+        attr.normal = vec3(NormalToWorld(ctx, primitiveTest.normal));
+        attr.color = vec4(vec2(thit), 0.0f, 0.0f);  // (t, iteration count) for ClosestHit_Julia
+        ctx.ReportHit(float(thit.x), /*hitKind*/ 0, attr);
     }
 }
 
+template <typename T>
 void ClosestHit_Julia(ShaderContext& ctx, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
-    ScopedFlushDenormals ftz;
+    [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     if (g_sceneCB.debugFlag) {
         rayPayload.color = vec4(1.0f, 0.0f, 0.0f, 0.0f);
         return;
     }
+    const tvec3<T> normal = tvec3<T>(attr.normal);
 
     // No shadow ray: the HLSL has it commented out.
     const bool shadowRayHit = false;
 
     // H1: with the local-unit t this point lies near the object-space ray origin, not on the surface.
-    const vec3 pos = ctx.ObjectRayOrigin() + ctx.RayTCurrent() * ctx.ObjectRayDirection();
-    vec4 albedo = vec4(3.5f * colorSurface(pos, vec2(attr.color)), 1.0f);
-    if (rayPayload.recursionDepth == MAX_RAY_RECURSION_DEPTH - 1) albedo += 1.65f * hlsl::step(0.0f, hlsl::abs(pos.y));
+    const tvec3<T> pos = tvec3<T>(ctx.ObjectRayOrigin()) + T(ctx.RayTCurrent()) * tvec3<T>(ctx.ObjectRayDirection());
+    tvec4<T> albedo = tvec4<T>(T(3.5f) * colorSurface(pos, tvec2<T>(attr.color)), T(1));
+    if (rayPayload.recursionDepth == MAX_RAY_RECURSION_DEPTH - 1)
+        albedo += T(1.65f) * hlsl::step(T(0), hlsl::abs(pos.y));
 
-    const float reflecCoef = 0.1f;
-    vec4 reflectedColor(0.0f);
-    if (reflecCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, attr.normal, reflecCoef, vec3(albedo), rayPayload.recursionDepth);
+    const T reflecCoef = T(0.1f);
+    tvec4<T> reflectedColor(T(0));
+    if (reflecCoef > T(0.001f))
+        reflectedColor = ReflectedColor(ctx, normal, reflecCoef, tvec3<T>(albedo), rayPayload.recursionDepth);
 
-    const float diffuseCoef = 0.6f;
-    const float specularCoef = 0.08f;
-    const float specularPower = 0.2f;
-    const vec4 phongColor =
-        CalculatePhongLighting(ctx, g_sceneCB, albedo, attr.normal, shadowRayHit, diffuseCoef, specularCoef, specularPower);
-    vec4 color = phongColor + reflectedColor;
-    color += rayPayload.color;
-    rayPayload.color = color;
+    const T diffuseCoef = T(0.6f);
+    const T specularCoef = T(0.08f);
+    const T specularPower = T(0.2f);
+    const tvec4<T> phongColor =
+        CalculatePhongLighting(ctx, g_sceneCB, albedo, normal, shadowRayHit, diffuseCoef, specularCoef, specularPower);
+    tvec4<T> color = phongColor + reflectedColor;
+    color += tvec4<T>(rayPayload.color);
+    rayPayload.color = vec4(color);
+}
+
+// Every export, with its math in T.
+template <typename T>
+void addExports(ShaderLibrary& lib) {
+    lib.addRayGeneration("Raygen", [](ShaderContext& ctx) { Raygen<T>(ctx); });
+    lib.addMiss<RayPayload>("Miss", Miss);
+    lib.addMiss<ShadowRayPayload>("Miss_Shadow", Miss_Shadow);
+    lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
+        "ClosestHit_Triangle", [](ShaderContext& ctx, RayPayload& payload,
+                                  const BuiltInTriangleIntersectionAttributes& attr) { ClosestHit_Triangle<T>(ctx, payload, attr); });
+    lib.addIntersection<ProceduralPrimitiveAttributes>("Intersection_Julia",
+                                                       [](ShaderContext& ctx) { Intersection_Julia<T>(ctx); });
+    lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
+        "ClosestHit_Julia", [](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
+            ClosestHit_Julia<T>(ctx, payload, attr);
+        });
+    lib.addIntersection<ProceduralPrimitiveAttributes>("Intersection_Pacman",
+                                                       [](ShaderContext& ctx) { Intersection_Pacman<T>(ctx); });
+    lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
+        "ClosestHit_Pacman", [](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
+            ClosestHit_Pacman<T>(ctx, payload, attr);
+        });
+    lib.addIntersection<ProceduralPrimitiveAttributes>("Intersection_Mandelbulb",
+                                                       [](ShaderContext& ctx) { Intersection_Mandelbulb<T>(ctx); });
+    lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
+        "ClosestHit_Mandelbulb", [](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
+            ClosestHit_Mandelbulb<T>(ctx, payload, attr);
+        });
 }
 
 }  // namespace
 
-std::shared_ptr<ShaderLibrary> makeProcedurayShaderLibrary() {
+std::shared_ptr<ShaderLibrary> makeProcedurayShaderLibrary(Precision precision) {
     auto lib = std::make_shared<ShaderLibrary>();
-    lib->addRayGeneration("Raygen", Raygen);
-    lib->addMiss<RayPayload>("Miss", Miss);
-    lib->addMiss<ShadowRayPayload>("Miss_Shadow", Miss_Shadow);
-    lib->addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>("ClosestHit_Triangle", ClosestHit_Triangle);
-    lib->addIntersection<ProceduralPrimitiveAttributes>("Intersection_Julia", Intersection_Julia);
-    lib->addClosestHit<RayPayload, ProceduralPrimitiveAttributes>("ClosestHit_Julia", ClosestHit_Julia);
-    lib->addIntersection<ProceduralPrimitiveAttributes>("Intersection_Pacman", Intersection_Pacman);
-    lib->addClosestHit<RayPayload, ProceduralPrimitiveAttributes>("ClosestHit_Pacman", ClosestHit_Pacman);
-    lib->addIntersection<ProceduralPrimitiveAttributes>("Intersection_Mandelbulb", Intersection_Mandelbulb);
-    lib->addClosestHit<RayPayload, ProceduralPrimitiveAttributes>("ClosestHit_Mandelbulb", ClosestHit_Mandelbulb);
+    if (precision == Precision::Double) addExports<double>(*lib);
+    else addExports<float>(*lib);
     return lib;
 }
 

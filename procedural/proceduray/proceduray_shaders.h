@@ -6,6 +6,11 @@
 // intersection / closest-hit pairs of the Julia set, the Pac-man and the Mandelbulb. The pure math lives in
 // procedural/math/; the entry points here transform the ray, call it, shade and TraceRay exactly as the HLSL
 // does, including its t-space bug (H1: intersection shaders report t in normalised local units).
+//
+// Precision (issue 3): the shader-internal math (local ray, marches, distance estimators, normals, lighting)
+// runs in T = float or double. The structs below are the GPU interface and stay float; values are rounded to
+// float where they cross it (ReportHit's t, attributes, payload colour, RayDesc, the render target). HLSL
+// literals are float, so double mode uses their float values. Float mode flushes denormals (H18); double does not.
 #pragma once
 
 #include <array>
@@ -17,6 +22,7 @@
 #include "core/math.h"
 #include "emulator/root_signature.h"
 #include "emulator/state_object.h"
+#include "procedural/precision.h"
 
 namespace refray::procedural::proceduray {
 
@@ -151,7 +157,8 @@ std::vector<dxr::HitGroupDesc> procedurayHitGroups();
 
 // Exports, with their HLSL names: Raygen, Miss, Miss_Shadow, ClosestHit_Triangle, Intersection_Julia,
 // ClosestHit_Julia, Intersection_Pacman, ClosestHit_Pacman, Intersection_Mandelbulb, ClosestHit_Mandelbulb.
-std::shared_ptr<dxr::ShaderLibrary> makeProcedurayShaderLibrary();
+// PORT: `precision` selects the scalar type of the shader-internal math (Precision::Double is not the GPU's).
+std::shared_ptr<dxr::ShaderLibrary> makeProcedurayShaderLibrary(Precision precision = Precision::Float);
 
 // ---- The slab's index and vertex buffers (§1.1) ----------------------------------------------------
 // What the scene uploads as g_indices (36 16-bit indices = 18 dwords) and g_vertices (8 vertices).
@@ -166,22 +173,29 @@ extern const std::array<Vertex, 8> kSlabVertices;
 // read as two aligned dwords the way a ByteAddressBuffer Load2 does. Dwords past `sizeInBytes` read 0.
 uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t sizeInBytes);
 
+// The helpers below are templates on the scalar type, defined and instantiated (float, double) in the .cpp.
+
 // FresnelReflectanceSchlick(I, N, f0) = f0 + (1 - f0)·pow(1 - saturate(dot(-I, N)), 5).
-vec3 FresnelReflectanceSchlick(vec3 I, vec3 N, vec3 f0);
+template <typename T>
+glm::vec<3, T> FresnelReflectanceSchlick(glm::vec<3, T> I, glm::vec<3, T> N, glm::vec<3, T> f0);
 
 // JuliaSets.hlsli colorSurface(pos, tn): the iteration-count palette (tn.y = n).
-vec3 colorSurface(vec3 pos, vec2 tn);
+template <typename T>
+glm::vec<3, T> colorSurface(glm::vec<3, T> pos, glm::vec<2, T> tn);
 
 // GenerateCameraRay: pixel centre, y flipped, unprojected with mul(float4(s, 0, 1), projectionToWorld).
 // Writes the ray's origin (cameraPosition) and normalised direction.
-void GenerateCameraRay(uvec2 index, uvec2 dimensions, vec3 cameraPosition, const Float4x4& projectionToWorld,
-                       vec3& origin, vec3& direction);
+template <typename T>
+void GenerateCameraRay(uvec2 index, uvec2 dimensions, glm::vec<3, T> cameraPosition, const Float4x4& projectionToWorld,
+                       glm::vec<3, T>& origin, glm::vec<3, T>& direction);
 
 // ClosestHit_Mandelbulb's own lighting (no scene light): the colour before the reflection is added.
 // D = WorldRayDirection(), N = attr.normal, trap = attr.color.
-vec4 MandelbulbSurfaceColor(vec3 D, vec3 N, vec4 trap);
+template <typename T>
+glm::vec<4, T> MandelbulbSurfaceColor(glm::vec<3, T> D, glm::vec<3, T> N, glm::vec<4, T> trap);
 
 // mul(v, M) for a row vector, summed in row order.
-vec4 mul(const vec4& v, const Float4x4& M);
+template <typename T>
+glm::vec<4, T> mul(const glm::vec<4, T>& v, const Float4x4& M);
 
 }  // namespace refray::procedural::proceduray

@@ -1,0 +1,226 @@
+// Ports: Microsoft D3D12RaytracingProceduralGeometry Raytracing.hlsl (every entry point), the shading helpers of
+// RaytracingShaderHelper.hlsli (camera ray, ray differentials, Fresnel, index loads) and CheckersTextureBoxFilter of
+// SignedDistancePrimitives.hlsli, plus the shared structs of RayTracingHlslCompat.h and RaytracingSceneDefines.h.
+// Facts: docs/reference-scene-d3d12-procedural.md (§1.4-1.9, §2, §4).
+//
+// The sample's shader library: one ray generation shader, two miss shaders, the ground plane's closest hit (Phong,
+// shadow, Fresnel reflection, box-filtered analytic grid from ray differentials, fog), the AABB closest hit, and the
+// three intersection shaders (analytic box and spheres, animated metaballs, seven sphere-traced SDFs). The pure math
+// lives in procedural/math/; the entry points here transform the ray, call it, shade and TraceRay as the HLSL does.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/math.h"
+#include "emulator/root_signature.h"
+#include "emulator/state_object.h"
+#include "procedural/math/fractals.h"
+
+namespace refray::procedural::d3d12 {
+
+// ---- Shader-visible structs (RayTracingHlslCompat.h) -------------------------------------------------
+
+// An HLSL float4x4 / XMMATRIX compiled with /Zpr: row-major, used with row vectors (mul(v, M) = v·M,
+// translation in row 3).
+struct Float4x4 {
+    std::array<std::array<float, 4>, 4> m{};
+};
+static_assert(sizeof(Float4x4) == 64);
+
+struct RayPayload {
+    vec4 color;
+    uint32_t recursionDepth;
+};
+static_assert(sizeof(RayPayload) == 20);
+
+// PORT: the C++ header declares `bool hit` (1 byte); the HLSL bool is 32 bits, which is what this mirrors (I11).
+struct ShadowRayPayload {
+    uint32_t hit;
+};
+static_assert(sizeof(ShadowRayPayload) == 4);
+
+// A world-space normal; HitKind is always 0.
+struct ProceduralPrimitiveAttributes {
+    vec3 normal;
+};
+static_assert(sizeof(ProceduralPrimitiveAttributes) == 12);
+
+// The root CBV b0. The HLSL cbuffer uses 136 bytes; the C++ struct (XMMATRIX-aligned) is 144.
+struct SceneConstantBuffer {
+    Float4x4 projectionToWorld;
+    vec4 cameraPosition;
+    vec4 lightPosition;
+    vec4 lightAmbientColor;
+    vec4 lightDiffuseColor;
+    float reflectance;  // never written or read (I10)
+    float elapsedTime;  // the geometry time T
+    vec2 padding;
+};
+static_assert(sizeof(SceneConstantBuffer) == 144);
+
+// The material: 12 root constants at b1 (§1.4).
+struct PrimitiveConstantBuffer {
+    vec4 albedo;
+    float reflectanceCoef;
+    float diffuseCoef;
+    float specularCoef;
+    float specularPower;
+    float stepScale;  // sphere-tracing step scale of the SDF primitives
+    vec3 padding;
+};
+static_assert(sizeof(PrimitiveConstantBuffer) == 48);
+
+// Per AABB primitive: 2 root constants at b2. instanceIndex is the primitive index i of §1.3 (it indexes
+// g_AABBPrimitiveAttributes); primitiveType is the enum of the hit group's intersection shader.
+struct PrimitiveInstanceConstantBuffer {
+    uint32_t instanceIndex;
+    uint32_t primitiveType;
+};
+static_assert(sizeof(PrimitiveInstanceConstantBuffer) == 8);
+
+// One element of StructuredBuffer<PrimitiveInstancePerFrameBuffer> (root SRV t3): S·R·Tr and its inverse.
+struct PrimitiveInstancePerFrameBuffer {
+    Float4x4 localSpaceToBottomLevelAS;
+    Float4x4 bottomLevelASToLocalSpace;
+};
+static_assert(sizeof(PrimitiveInstancePerFrameBuffer) == 128);
+
+struct Vertex {
+    vec3 position;
+    vec3 normal;
+};
+static_assert(sizeof(Vertex) == 24);
+
+// LocalRootSignature::{Triangle, AABB}::RootArguments: the record bytes after the identifier.
+struct TriangleRootArguments {
+    PrimitiveConstantBuffer materialCb;
+};
+static_assert(sizeof(TriangleRootArguments) == 48);
+struct AABBRootArguments {
+    PrimitiveConstantBuffer materialCb;
+    PrimitiveInstanceConstantBuffer aabbCB;
+};
+static_assert(sizeof(AABBRootArguments) == 56);
+
+// ---- Constants (RayTracingHlslCompat.h) -----------------------------------------------------------------
+
+inline constexpr uint32_t MAX_RAY_RECURSION_DEPTH = 3;
+inline constexpr uint32_t N_FRACTAL_ITERATIONS = uint32_t(math::d3d12::N_FRACTAL_ITERATIONS);
+inline constexpr vec4 ChromiumReflectance{0.549f, 0.556f, 0.554f, 1.0f};
+inline constexpr vec4 BackgroundColor{0.8f, 0.9f, 1.0f, 1.0f};
+inline constexpr float InShadowRadiance = 0.35f;
+
+// The pipeline's shader config (§1.9): max(sizeof RayPayload, C++ sizeof(bool)) and the attribute struct.
+inline constexpr uint32_t kMaxPayloadSizeInBytes = 20;
+inline constexpr uint32_t kMaxAttributeSizeInBytes = 12;
+
+namespace RayType {
+enum Enum : uint32_t { Radiance = 0, Shadow = 1, Count = 2 };
+}
+
+// TraceRayParameters: InstanceMask ~0; hit-group offset = ray type, geometry stride = ray type count;
+// miss offset = ray type.
+namespace TraceRayParameters {
+inline constexpr uint32_t InstanceMask = ~0u;
+inline constexpr uint32_t GeometryStride = RayType::Count;
+}  // namespace TraceRayParameters
+
+// primitiveType per intersection shader.
+namespace AnalyticPrimitive {
+enum Enum : uint32_t { AABB = 0, Spheres = 1, Count = 2 };
+}
+namespace VolumetricPrimitive {
+enum Enum : uint32_t { Metaballs = 0, Count = 1 };
+}
+using SignedDistancePrimitive = math::d3d12::SignedDistancePrimitive;  // MiniSpheres (0) ... FractalPyramid (6)
+
+// ---- Root signatures (RaytracingSceneDefines.h, §1.9) -------------------------------------------------
+
+// GlobalRootSignature::Slot.
+enum GlobalRootParameter : uint32_t {
+    kOutputView = 0,             // table {UAV u0}: RWTexture2D<float4> g_renderTarget
+    kAccelerationStructure = 1,  // root SRV t0: g_scene
+    kSceneConstant = 2,          // root CBV b0: g_sceneCB
+    kAABBattributeBuffer = 3,    // root SRV t3: g_AABBPrimitiveAttributes (10 elements)
+    kVertexBuffers = 4,          // table {SRV t1, t2}: g_indices (raw), g_vertices (structured)
+};
+// LocalRootSignature::Triangle::Slot and LocalRootSignature::AABB::Slot.
+enum LocalRootParameter : uint32_t {
+    kMaterialConstant = 0,  // 12 constants at b1: l_materialCB
+    kGeometryIndex = 1,     // 2 constants at b2: l_aabbCB (AABB only)
+};
+
+dxr::RootSignatureDesc globalRootSignatureDesc();         // named "GlobalRootSignature"
+dxr::RootSignatureDesc triangleLocalRootSignatureDesc();  // named "Triangle"
+dxr::RootSignatureDesc aabbLocalRootSignatureDesc();      // named "AABB"
+
+// ---- Hit groups (APP CreateHitGroupSubobjects, §1.8) -------------------------------------------------
+
+// MyHitGroup_Triangle[_ShadowRay], then MyHitGroup_AABB_{Analytic,Volumetric,SignedDistance}Primitive[_ShadowRay].
+// Shadow groups have no closest hit; no group has an any-hit shader.
+std::vector<dxr::HitGroupDesc> d3d12HitGroups();
+// The hit groups that take the "Triangle" local root signature, and those that take "AABB".
+std::vector<std::string> triangleHitGroupNames();
+std::vector<std::string> aabbHitGroupNames();
+
+// ---- The shader library -------------------------------------------------------------------------------
+
+// Exports, with their HLSL names: MyRaygenShader, MyClosestHitShader_Triangle, MyClosestHitShader_AABB, MyMissShader,
+// MyMissShader_ShadowRay, MyIntersectionShader_AnalyticPrimitive, MyIntersectionShader_VolumetricPrimitive,
+// MyIntersectionShader_SignedDistancePrimitive.
+std::shared_ptr<dxr::ShaderLibrary> makeD3D12ShaderLibrary();
+
+// ---- The ground plane's index and vertex buffers (§1.2) ----------------------------------------------
+// What the app uploads as g_indices (6 16-bit indices) and g_vertices (4 vertices).
+// PORT: MyClosestHitShader_Triangle reads these copies instead of the buffers bound through global parameter 4,
+// because ShaderContext offers no way to read a buffer SRV through a descriptor table.
+extern const std::array<uint16_t, 6> kPlaneIndices;
+extern const std::array<Vertex, 4> kPlaneVertices;
+
+// ---- Pure helpers of the entry points, exposed for tests ---------------------------------------------
+// PORT: intrinsics these helpers read in HLSL (DispatchRaysIndex/Dimensions, WorldRayDirection) are parameters.
+
+// mul(v, M) for a row vector, summed in row order.
+vec4 mul(const vec4& v, const Float4x4& M);
+
+// GenerateCameraRay: pixel centre, y flipped, unprojected with mul(float4(s, t, 0, 1), projectionToWorld), divided
+// by w; origin = cameraPosition, direction normalised (§2.1).
+void GenerateCameraRay(uvec2 index, uvec2 dimensions, vec3 cameraPosition, const Float4x4& projectionToWorld,
+                       vec3& origin, vec3& direction);
+
+// Load3x16BitIndices: the three 16-bit indices at byte `offsetBytes`, read as two aligned dwords the way a
+// ByteAddressBuffer Load2 does. Dwords past `sizeInBytes` read 0.
+uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t sizeInBytes);
+
+// FresnelReflectanceSchlick(I, N, f0) = f0 + (1 - f0)·pow(1 - saturate(dot(-I, N)), 5).
+vec3 FresnelReflectanceSchlick(vec3 I, vec3 N, vec3 f0);
+
+// CheckersTextureBoxFilter: the grid of lines 1/ratio wide at every integer u and v, box-filtered over
+// w = max(|dpdx|, |dpdy|); 1 on the white cells, 0 on a line (§2.9 step 3).
+float CheckersTextureBoxFilter(vec2 uv, vec2 dpdx, vec2 dpdy, uint32_t ratio);
+
+// CalculateRayDifferentials: the primary camera rays of pixels index + (1,0) and index + (0,1) intersected with the
+// plane through hitPosition with normal surfaceNormal; the footprint in uv = position.xz (I7).
+void CalculateRayDifferentials(vec2& ddx_uv, vec2& ddy_uv, vec2 uv, vec3 hitPosition, vec3 surfaceNormal,
+                               vec3 cameraPosition, const Float4x4& projectionToWorld, uvec2 dispatchRaysIndex,
+                               uvec2 dispatchRaysDimensions);
+
+// AnalyticalCheckersTexture: CheckersTextureBoxFilter(hitPosition.xz, footprint, 50).
+float AnalyticalCheckersTexture(vec3 hitPosition, vec3 surfaceNormal, vec3 cameraPosition,
+                                const Float4x4& projectionToWorld, uvec2 dispatchRaysIndex,
+                                uvec2 dispatchRaysDimensions);
+
+// CalculatePhongLighting: ambient (darkened towards -y) + diffuse (scaled by InShadowRadiance in shadow) + white
+// specular (only when not in shadow, not gated by N·L: I8) for the point light of g_sceneCB (§2.11).
+vec4 CalculatePhongLighting(const SceneConstantBuffer& sceneCB, vec4 albedo, vec3 normal, bool isInShadow,
+                            float diffuseCoef, float specularCoef, float specularPower, vec3 hitPosition,
+                            vec3 worldRayDirection);
+
+// The "visibility falloff" of both closest hits: lerp(color, BackgroundColor, 1 - exp(-0.000002·t³)).
+vec4 ApplyVisibilityFalloff(vec4 color, float t);
+
+}  // namespace refray::procedural::d3d12
