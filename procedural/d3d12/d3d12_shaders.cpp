@@ -115,10 +115,11 @@ uint32_t loadDword(const uint8_t* data, size_t sizeInBytes, uint32_t offset) {
 
 }  // namespace
 
-uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t sizeInBytes) {
+namespace {
+
+// The index triplet inside the 8 bytes Load2 read at the dword-aligned offset.
+uvec3 unpack3x16BitIndices(uint32_t offsetBytes, uvec2 four16BitIndices) {
     const uint32_t dwordAlignedOffset = offsetBytes & ~3u;
-    const uvec2 four16BitIndices(loadDword(indices, sizeInBytes, dwordAlignedOffset),
-                                 loadDword(indices, sizeInBytes, dwordAlignedOffset + 4));
     uvec3 result;
     if (dwordAlignedOffset == offsetBytes) {  // aligned: { 0 1 | 2 - }
         result.x = four16BitIndices.x & 0xffff;
@@ -130,6 +131,14 @@ uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t si
         result.z = (four16BitIndices.y >> 16) & 0xffff;
     }
     return result;
+}
+
+}  // namespace
+
+uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t sizeInBytes) {
+    const uint32_t dwordAlignedOffset = offsetBytes & ~3u;
+    return unpack3x16BitIndices(offsetBytes, uvec2(loadDword(indices, sizeInBytes, dwordAlignedOffset),
+                                                   loadDword(indices, sizeInBytes, dwordAlignedOffset + 4)));
 }
 
 void GenerateCameraRay(uvec2 index, uvec2 dimensions, vec3 cameraPosition, const Float4x4& projectionToWorld,
@@ -352,10 +361,12 @@ void MyClosestHitShader_Triangle(ShaderContext& ctx, RayPayload& rayPayload,
     const uint32_t indicesPerTriangle = 3;
     const uint32_t triangleIndexStride = indicesPerTriangle * indexSizeInBytes;
     const uint32_t baseIndex = ctx.PrimitiveIndex() * triangleIndexStride;
-    // PORT: g_indices / g_vertices are the built-in copies (see kPlaneIndices); out-of-range reads give 0.
-    const uvec3 indices = Load3x16BitIndices(baseIndex, reinterpret_cast<const uint8_t*>(kPlaneIndices.data()),
-                                             sizeof(kPlaneIndices));
-    const vec3 triangleNormal = indices[0] < kPlaneVertices.size() ? kPlaneVertices[indices[0]].normal : vec3(0.0f);
+    // g_indices is t1 (descriptor 0 of the table), g_vertices t2 (descriptor 1); out-of-range reads give 0.
+    const GpuDescriptorHandle vertexBuffers = ctx.globalDescriptorTable(kVertexBuffers);
+    const uvec3 indices = unpack3x16BitIndices(
+        baseIndex, ctx.loadFromTable<uvec2>(vertexBuffers, /*g_indices*/ 0, /*Load2 at*/ baseIndex & ~3u));
+    const vec3 triangleNormal =
+        ctx.loadFromTable<Vertex>(vertexBuffers, /*g_vertices*/ 1, uint64_t(indices[0]) * sizeof(Vertex)).normal;
 
     // Shadow component.
     const bool shadowRayHit = TraceShadowRayTowardsLight(ctx, g_sceneCB, rayPayload.recursionDepth);

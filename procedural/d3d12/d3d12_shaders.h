@@ -175,9 +175,8 @@ std::vector<std::string> aabbHitGroupNames();
 std::shared_ptr<dxr::ShaderLibrary> makeD3D12ShaderLibrary();
 
 // ---- The ground plane's index and vertex buffers (§1.2) ----------------------------------------------
-// What the app uploads as g_indices (6 16-bit indices) and g_vertices (4 vertices).
-// PORT: MyClosestHitShader_Triangle reads these copies instead of the buffers bound through global parameter 4,
-// because ShaderContext offers no way to read a buffer SRV through a descriptor table.
+// What the app uploads as g_indices (6 16-bit indices, a raw view) and g_vertices (4 vertices, stride 24), which
+// MyClosestHitShader_Triangle reads through the descriptor table of global parameter 4.
 extern const std::array<uint16_t, 6> kPlaneIndices;
 extern const std::array<Vertex, 4> kPlaneVertices;
 

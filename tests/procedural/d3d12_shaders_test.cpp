@@ -5,6 +5,7 @@
 #include "procedural/d3d12/d3d12_shaders.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -169,6 +170,8 @@ TEST(D3D12Shaders, FresnelAndVisibilityFalloff) {
 TEST(D3D12Shaders, CheckersTextureBoxFilterIntegratesTheGridLines) {
     // Footprint 0.02 centred at u = 3.005 covers [2.995, 3.015]: 0.015 of line, i.e. i_x = 0.75; v = 7.5 sees no line.
     EXPECT_NEAR(CheckersTextureBoxFilter(vec2(3.005f, 7.5f), vec2(0.02f, 0.0f), vec2(0.0f, 0.02f), 50), 0.25f, 1e-4f);
+    // Footprint 0.04 over [2.99, 3.03] holds the whole line: i_x = 0.5.
+    EXPECT_NEAR(CheckersTextureBoxFilter(vec2(3.01f, 7.5f), vec2(0.0f, 0.04f), vec2(0.04f, 0.0f), 50), 0.5f, 1e-4f);
     // Cell interior and a point on a line, both with a tiny footprint.
     EXPECT_NEAR(CheckersTextureBoxFilter(vec2(0.5f, 0.5f), vec2(1e-3f, 0.0f), vec2(0.0f, 1e-3f), 50), 1.0f, 1e-5f);
     EXPECT_NEAR(CheckersTextureBoxFilter(vec2(4.01f, 0.5f), vec2(1e-3f, 0.0f), vec2(0.0f, 1e-3f), 50), 0.0f, 1e-3f);
@@ -484,8 +487,8 @@ public:
         heap.setBuffer(1, DescriptorRangeType::SRV,
                        {memory.upload(kPlaneIndices.data(), sizeof(kPlaneIndices), "g_indices"), sizeof(kPlaneIndices), 0});
         heap.setBuffer(2, DescriptorRangeType::SRV,
-                       {memory.upload(kPlaneVertices.data(), sizeof(kPlaneVertices), "g_vertices"),
-                        sizeof(kPlaneVertices), sizeof(Vertex)});
+                       {memory.upload(boundVertices.data(), sizeof(boundVertices), "g_vertices"),
+                        sizeof(boundVertices), sizeof(Vertex)});
 
         GlobalRootArguments globals(globalSignature);
         globals.setDescriptor(kOutputView, heap.gpuHandle(0));
@@ -503,6 +506,7 @@ public:
     RayDesc probeRay;
     Probe probe;
     Image output;
+    std::array<Vertex, 4> boundVertices = kPlaneVertices;  // what g_vertices holds (the BLAS uses kPlaneVertices)
 
 private:
     void addProbeShaders() {
@@ -749,38 +753,52 @@ TEST(D3D12Shaders, WholeSceneFirstHitsMatchTheCheckValues) {
 // ---- The closest hits and miss shaders through MyRaygenShader -------------------------------------------
 
 // The ground colour of §2.9/§2.11 in double for a ray straight down (D = -y) that hits P at distance t, with the
-// background as the reflection (nothing above P).
-dvec4 expectedGroundColor(dvec3 P, double t, bool inShadow, double checkers) {
-    const dvec3 D(0, -1, 0), N(0, 1, 0), light(0, 18, -20);
+// background as the reflection (nothing above P) and N the normal the shader read from g_vertices.
+dvec4 expectedGroundColor(dvec3 P, double t, bool inShadow, double checkers, dvec3 N = dvec3(0, 1, 0)) {
+    const dvec3 D(0, -1, 0), light(0, 18, -20);
     const dvec4 albedo(0.9, 0.9, 0.9, 1.0), background(0.8, 0.9, 1.0, 1.0);
     const dvec3 L = glm::normalize(P - light);
     const double Kd = std::clamp(glm::dot(-L, N), 0.0, 1.0);
     const dvec4 diffuse = (inShadow ? 0.35 : 1.0) * 1.0 * Kd * dvec4(0.6, 0.6, 0.6, 1.0) * albedo;
     const dvec3 R = glm::normalize(L - 2.0 * glm::dot(N, L) * N);
     const dvec4 specular(inShadow ? 0.0 : 0.4 * std::pow(std::clamp(glm::dot(R, -D), 0.0, 1.0), 50.0));
-    const dvec4 ambient = albedo * dvec4(0.25, 0.25, 0.25, 1.0);  // a = 1 for an up normal
-    const dvec4 fresnel(dvec3(0.9), 1.0);                         // head-on: f0 = albedo
+    const double a = 1.0 - std::clamp(-N.y, 0.0, 1.0);
+    const dvec4 ambient = albedo * (dvec4(0.25, 0.25, 0.25, 1.0) - 0.1 + 0.1 * a);  // lerp(A - 0.1, A, a)
+    const double cosi = std::clamp(glm::dot(-D, N), 0.0, 1.0);
+    const dvec4 fresnel(dvec3(0.9) + 0.1 * std::pow(1.0 - cosi, 5.0), 1.0);
     const dvec4 reflected = 0.25 * fresnel * background;
     const dvec4 color = checkers * (ambient + diffuse + specular + reflected);
     const double f = 1.0 - std::exp(-0.000002 * t * t * t);
     return color + f * (background - color);
 }
 
-// A 1×1 camera 10 above (3.005, 0, 7.5) looking down; its neighbour rays land 0.02 away, so the box filter covers
-// [2.995, 3.015] in u: three quarters of the line at u = 3, i.e. a grid factor of 0.25. The shadow ray and the
-// reflection ray both miss.
+// A 1×1 camera 10 above (3.01, 0, 7.5) looking down; its neighbour rays land 0.04 away, so the box filter covers
+// [2.99, 3.03] in u: the whole 0.02-wide line at u = 3 is half of it, i.e. a grid factor of 0.5. The shadow ray and
+// the reflection ray both miss.
 TEST(D3D12Shaders, GroundPlaneGridShadingAndFog) {
     D3D12Rig rig(true, {});
-    rig.setPointCamera(vec3(3.005f, 10.0f, 7.5f), vec3(0, -1, 0), vec3(0.001f, 0, 0), vec3(0, 0, 0.001f));
+    rig.setPointCamera(vec3(3.01f, 10.0f, 7.5f), vec3(0, -1, 0), vec3(0.002f, 0, 0), vec3(0, 0, 0.002f));
     const DispatchResult result = rig.dispatch("MyRaygenShader", false);
     EXPECT_EQ(result.stats.raysTraced, 3u);  // primary, shadow, reflection
     EXPECT_EQ(result.stats.invocationsOf(ShaderStage::Miss), 2u);
     EXPECT_EQ(result.stats.invocationsOf(ShaderStage::ClosestHit), 1u);
 
-    EXPECT_NEAR(AnalyticalCheckersTexture(vec3(3.005f, 0.0f, 7.5f), vec3(0, 1, 0), vec3(rig.scene.cameraPosition),
+    EXPECT_NEAR(AnalyticalCheckersTexture(vec3(3.01f, 0.0f, 7.5f), vec3(0, 1, 0), vec3(rig.scene.cameraPosition),
                                           rig.scene.projectionToWorld, uvec2(0), uvec2(1)),
-                0.25f, 1e-4f);
-    const dvec4 expected = expectedGroundColor(dvec3(3.005, 0, 7.5), 10.0, false, 0.25);
+                0.5f, 1e-4f);
+    const dvec4 expected = expectedGroundColor(dvec3(3.01, 0, 7.5), 10.0, false, 0.5);
+    const vec4 got = rig.output.at(0, 0);
+    for (int c = 0; c < 4; ++c) EXPECT_NEAR(got[c], expected[c], 1e-4) << "component " << c;
+}
+
+// MyClosestHitShader_Triangle takes its normal from the bound g_vertices[g_indices[3·PrimitiveIndex()]]: with
+// downward normals there the same hit shades with the 0.15 ambient, no diffuse and a Fresnel factor of 1.
+TEST(D3D12Shaders, GroundPlaneNormalComesFromTheBoundVertexBuffer) {
+    D3D12Rig rig(true, {});
+    for (Vertex& v : rig.boundVertices) v.normal = vec3(0, -1, 0);
+    rig.setPointCamera(vec3(7.2f, 10.0f, -3.2f), vec3(0, -1, 0), vec3(1e-4f, 0, 0), vec3(0, 0, 1e-4f));
+    rig.dispatch("MyRaygenShader", false);
+    const dvec4 expected = expectedGroundColor(dvec3(7.2, 0, -3.2), 10.0, false, 1.0, dvec3(0, -1, 0));
     const vec4 got = rig.output.at(0, 0);
     for (int c = 0; c < 4; ++c) EXPECT_NEAR(got[c], expected[c], 1e-4) << "component " << c;
 }
