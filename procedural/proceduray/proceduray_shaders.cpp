@@ -534,8 +534,8 @@ void ClosestHit_Mandelbulb(ShaderContext& ctx, RayPayload& rayPayload, const Pro
 
     tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, normal, T(l_materialCB.reflectanceCoef), tvec3<T>(vec3(l_materialCB.albedo)),
-                                        rayPayload.recursionDepth);
+        reflectedColor = ReflectedColor(ctx, normal, T(l_materialCB.reflectanceCoef),
+                                        tvec3<T>(vec3(l_materialCB.albedo)), rayPayload.recursionDepth);
 
     color = color + reflectedColor;
     color += tvec4<T>(rayPayload.color);
@@ -608,8 +608,10 @@ void addExports(ShaderLibrary& lib) {
     lib.addMiss<RayPayload>("Miss", Miss);
     lib.addMiss<ShadowRayPayload>("Miss_Shadow", Miss_Shadow);
     lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
-        "ClosestHit_Triangle", [](ShaderContext& ctx, RayPayload& payload,
-                                  const BuiltInTriangleIntersectionAttributes& attr) { ClosestHit_Triangle<T>(ctx, payload, attr); });
+        "ClosestHit_Triangle",
+        [](ShaderContext& ctx, RayPayload& payload, const BuiltInTriangleIntersectionAttributes& attr) {
+            ClosestHit_Triangle<T>(ctx, payload, attr);
+        });
     lib.addIntersection<ProceduralPrimitiveAttributes>("Intersection_Julia",
                                                        [](ShaderContext& ctx) { Intersection_Julia<T>(ctx); });
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
@@ -625,7 +627,8 @@ void addExports(ShaderLibrary& lib) {
     lib.addIntersection<ProceduralPrimitiveAttributes>("Intersection_Mandelbulb",
                                                        [](ShaderContext& ctx) { Intersection_Mandelbulb<T>(ctx); });
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
-        "ClosestHit_Mandelbulb", [](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
+        "ClosestHit_Mandelbulb",
+        [](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
             ClosestHit_Mandelbulb<T>(ctx, payload, attr);
         });
 }

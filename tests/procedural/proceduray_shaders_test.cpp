@@ -4,6 +4,7 @@
 #include "procedural/proceduray/proceduray_shaders.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <map>
@@ -13,6 +14,8 @@
 
 #include "emulator/device.h"
 #include "emulator/shader_api.h"
+#include "procedural/math/fractals.h"
+#include "procedural/math/sdf.h"
 
 namespace refray::procedural::proceduray {
 namespace {
@@ -40,6 +43,21 @@ TEST(ProcedurayShaders, EveryHlslExportExistsWithItsStage) {
         const ShaderExport* e = lib->find(name);
         ASSERT_NE(e, nullptr) << name;
         EXPECT_EQ(e->stage, stage) << name;
+    }
+}
+
+// PORT (makeProcedurayShaderLibrary's precision): the double library has the same exports and interface types;
+// proceduray_contract_test.cpp runs every intersection shader in both and bounds the differences.
+TEST(ProcedurayShaders, PORT_DoublePrecisionLibraryHasTheSameInterface) {
+    const auto f = makeProcedurayShaderLibrary(Precision::Float);
+    const auto d = makeProcedurayShaderLibrary(Precision::Double);
+    ASSERT_EQ(f->exports().size(), d->exports().size());
+    for (const auto& [name, e] : f->exports()) {
+        const ShaderExport* other = d->find(name);
+        ASSERT_NE(other, nullptr) << name;
+        EXPECT_EQ(other->stage, e.stage) << name;
+        EXPECT_EQ(other->payload, e.payload) << name;
+        EXPECT_EQ(other->attributes, e.attributes) << name;
     }
 }
 
@@ -196,6 +214,13 @@ public:
         g.Triangles.VertexBuffer = {memory.upload(kSlabVertices.data(), sizeof(kSlabVertices), "slab vertices"),
                                     sizeof(Vertex)};
         build(g, transform, 0);
+    }
+
+    // Binds `vertices` as g_vertices (descriptor 2 of the table at global parameter 4).
+    void bindVertices(const std::array<Vertex, 8>& vertices) {
+        heap_->setBuffer(2, DescriptorRangeType::SRV,
+                         {device.memory().upload(vertices.data(), sizeof(vertices), "g_vertices"), sizeof(vertices),
+                          sizeof(Vertex)});
     }
 
     // The ray the probe ray generation traces with the radiance arguments of §1.4.
@@ -441,6 +466,97 @@ TEST(ProcedurayShaders, RaygenShadesTheSlabTopWithPhongAndReflection) {
                                 0.25 * albedo * glm::dvec4(0.6, 0.7, 0.9, 1.0);
     const vec4 got = rig.output.at(0, 0);
     for (int c = 0; c < 4; ++c) EXPECT_NEAR(got[c], expected[c], 1e-4) << "component " << c;
+}
+
+// PORT (Raygen): the render target keeps the float colour; quantisation to R8G8B8A8_UNORM happens only when
+// the image is written out. The Pac-man head's red and green channels are not multiples of 1/255.
+TEST(ProcedurayShaders, PORT_RaygenStoresUnquantisedFloats) {
+    ProcedurayRig rig = pacmanA();
+    rig.scene.cameraPosition = vec4(35, -45, 50, 1);
+    rig.scene.projectionToWorld.m[3] = {35.0f, -45.0f, 40.0f, 1.0f};
+    rig.dispatch("Raygen", "HitGroup_Pacman", "Miss");
+    const vec4 got = rig.output.at(0, 0);
+    for (int c = 0; c < 2; ++c) {
+        const float quantised = std::round(std::clamp(got[c], 0.0f, 1.0f) * 255.0f) / 255.0f;
+        EXPECT_GT(std::fabs(got[c] - quantised), 1e-5f) << "component " << c;
+    }
+}
+
+// PORT (kSlabIndices / ClosestHit_Triangle): the slab's normals come from the built-in copies, not from the
+// g_vertices bound at global parameter 4: binding vertices with zero normals leaves the shading unchanged.
+TEST(ProcedurayShaders, PORT_ClosestHitTriangleReadsTheBuiltInSlabCopies) {
+    constexpr PrimitiveConstantBuffer kPlaneMaterial{{1.0f, 0.9f, 0.7f, 1.0f}, 0.25f, 1.0f, 0.4f, 50.0f, 1.0f, vec3(0.0f)};
+    auto render = [&](bool zeroNormals) {
+        ProcedurayRig rig(Matrix3x4::scale(vec3(120, 15, 120)), kPlaneMaterial);
+        if (zeroNormals) {
+            std::array<Vertex, 8> vertices = kSlabVertices;
+            for (Vertex& v : vertices) v.normal = vec3(0.0f);
+            rig.bindVertices(vertices);
+        }
+        rig.scene.cameraPosition = vec4(0, 10, 0, 1);
+        rig.scene.projectionToWorld.m[3] = {0.0f, 9.0f, 0.0f, 1.0f};
+        rig.dispatch("Raygen", "HitGroup_Triangle", "Miss");
+        return rig.output.at(0, 0);
+    };
+    const vec4 builtIn = render(false);
+    EXPECT_GT(builtIn.x, 0.5f);  // lit from +y: the normal is not zero
+    EXPECT_EQ(render(true), builtIn);
+}
+
+// Pac-man A's mouth axis: o = (35,-35,50), d = -z, i.e. local o = (0,0,1), d = (0,0,-1).
+constexpr float kT1 = 15.8429795f;  // tau = 176/300: the mouth wide open
+
+// PORT (GetDistanceFromSignedDistancePrimitive): the mouth interpolant is computed once per IS instead of in
+// every distance evaluation. It depends on time only, so the IS's t equals, bit for bit, a march that
+// recomputes PacmanMouthInterpolant(time) inside every evaluation, as the HLSL does.
+TEST(ProcedurayShaders, PORT_PacmanMouthComputedOncePerIntersectionMatchesPerEvaluation) {
+    ProcedurayRig rig = pacmanA();
+    rig.scene.elapsedTime = kT1;
+    rig.probeRay = {vec3(35, -35, 50), 0.0f, vec3(0, 0, -1), 10000.0f};
+    rig.dispatch("RG_Probe", "Probe_Intersection_Pacman", "Miss_Probe");
+    ASSERT_EQ(rig.probe.closestHits, 1);
+
+    const float time = kT1;
+    const auto perEvaluation = [time](const vec3& p) {
+        return math::pacman::pacMan(p, math::pacman::PacmanMouthInterpolant(time));
+    };
+    const Float4x4 w2o = rowVectorForm(*affineInverse(Matrix3x4::translation(vec3(35, -35, 0)) * Matrix3x4::scale(vec3(50))));
+    math::Ray<float> local;
+    local.origin = vec3(mul(vec4(35, -35, 50, 1), w2o));
+    local.direction = hlsl::normalize(vec3(mul(vec4(0, 0, -1, 0), w2o)));
+    hlsl::ScopedFlushDenormals ftz;
+    const math::SphereTraceResult<float> hlslForm =
+        math::RaySignedDistancePrimitiveTest(local, math::RayExtent<float>{0.0f, 10000.0f, true, false}, perEvaluation);
+    ASSERT_TRUE(hlslForm.hit);
+    EXPECT_EQ(rig.probe.t, hlslForm.thit);
+    // The open mouth moves the hit from the head (0.5 at T0's nearly shut mouth: apex z = 0.45) to the apex
+    // at z = 0.5 - (0.05 + 0.4 * 176/300) = 0.2153.
+    EXPECT_NEAR(rig.probe.t, 1.0f - 0.2153f, 1e-3f);
+}
+
+// PORT (Intersection_Julia): the HLSL's cut animation (iMax from 10.5·time, deltaT) is computed and ignored,
+// and the port does not compute it: the Julia's hit does not depend on the time.
+TEST(ProcedurayShaders, PORT_JuliaIgnoresTheTime) {
+    Matrix3x4 m;
+    m.m[0] = {100.0f, 0.0f, 0.0f, 0.0f};
+    m.m[1] = {0.0f, -29.9999962f, 0.0507354662f, 130.0f};
+    m.m[2] = {0.0f, -0.0152206402f, -99.9999847f, 75.0f};
+    constexpr PrimitiveConstantBuffer kJuliaMaterial{{1.0f, 0.5f, 0.5f, 1.0f}, 0.2f, 0.6f, 0.7f, 50.0f, 1.0f, vec3(0.0f)};
+    Probe first;
+    for (const float time : {0.0f, kT1, 7.3f, 100.0f}) {
+        ProcedurayRig rig({-3.5f, -3.5f, -3.5f, 3.5f, 3.5f, 3.5f}, m, 0, SignedDistancePrimitive::JuliaSets, kJuliaMaterial);
+        rig.scene.elapsedTime = time;
+        rig.probeRay = {vec3(0, 20, 74.96f), 0.0f, vec3(0, 1, 0), 10000.0f};
+        rig.dispatch("RG_Probe", "Probe_Intersection_Julia", "Miss_Probe");
+        ASSERT_EQ(rig.probe.closestHits, 1) << time;
+        if (time == 0.0f) {
+            first = rig.probe;
+            continue;
+        }
+        EXPECT_EQ(rig.probe.t, first.t) << time;
+        EXPECT_EQ(rig.probe.attr.normal, first.attr.normal) << time;
+        EXPECT_EQ(rig.probe.attr.color, first.attr.color) << time;
+    }
 }
 
 }  // namespace
