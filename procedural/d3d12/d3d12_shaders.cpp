@@ -29,34 +29,15 @@ const std::array<Vertex, 4> kPlaneVertices = {{
 
 // ---- Root signatures and hit groups ----------------------------------------------------------------
 
-RootSignatureDesc globalRootSignatureDesc() {
-    RootSignatureDesc desc;
-    desc.name = "GlobalRootSignature";
-    desc.parameters = {
-        RootParameter::table({DescriptorRange{DescriptorRangeType::UAV, 1, 0, 0, 0}}),  // u0
-        RootParameter::srv(0),                                                           // t0
-        RootParameter::cbv(0),                                                           // b0
-        RootParameter::srv(3),                                                           // t3
-        RootParameter::table({DescriptorRange{DescriptorRangeType::SRV, 2, 1, 0, 0}}),  // t1, t2
-    };
-    return desc;
-}
+RootSignatureDesc globalRootSignatureDesc() { return sampleGlobalRootSignatureDesc("GlobalRootSignature"); }
 
 RootSignatureDesc triangleLocalRootSignatureDesc() {
-    RootSignatureDesc desc;
-    desc.name = "Triangle";
-    desc.flags = ROOT_SIGNATURE_FLAG_LOCAL_ROOT_SIGNATURE;
-    desc.parameters = {RootParameter::constants(sizeof(PrimitiveConstantBuffer) / 4, 1)};
-    return desc;
+    return sampleTriangleLocalRootSignatureDesc("Triangle", sizeof(PrimitiveConstantBuffer));
 }
 
 RootSignatureDesc aabbLocalRootSignatureDesc() {
-    RootSignatureDesc desc;
-    desc.name = "AABB";
-    desc.flags = ROOT_SIGNATURE_FLAG_LOCAL_ROOT_SIGNATURE;
-    desc.parameters = {RootParameter::constants(sizeof(PrimitiveConstantBuffer) / 4, 1),
-                       RootParameter::constants(sizeof(PrimitiveInstanceConstantBuffer) / 4, 2)};
-    return desc;
+    return sampleProceduralLocalRootSignatureDesc("AABB", sizeof(PrimitiveConstantBuffer),
+                                                  sizeof(PrimitiveInstanceConstantBuffer));
 }
 
 std::vector<HitGroupDesc> d3d12HitGroups() {

@@ -18,18 +18,14 @@
 #include "core/math.h"
 #include "emulator/root_signature.h"
 #include "emulator/state_object.h"
+#include "procedural/sample_layout.h"
 #include "procedural/math/fractals.h"
 
 namespace refray::procedural::d3d12 {
 
 // ---- Shader-visible structs (RayTracingHlslCompat.h) -------------------------------------------------
 
-// An HLSL float4x4 / XMMATRIX compiled with /Zpr: row-major, used with row vectors (mul(v, M) = v·M,
-// translation in row 3).
-struct Float4x4 {
-    std::array<std::array<float, 4>, 4> m{};
-};
-static_assert(sizeof(Float4x4) == 64);
+using procedural::Float4x4;  // procedural/sample_layout.h
 
 struct RayPayload {
     vec4 color;

@@ -22,18 +22,14 @@
 #include "core/math.h"
 #include "emulator/root_signature.h"
 #include "emulator/state_object.h"
+#include "procedural/sample_layout.h"
 #include "procedural/precision.h"
 
 namespace refray::procedural::proceduray {
 
 // ---- Shader-visible structs (HLSL layout; the C++ side of the shared headers) ---------------------
 
-// An HLSL float4x4 compiled with /Zpr: row-major, used with row vectors (mul(v, M) = v·M, translation
-// in row 3). Same memory layout as a DirectXMath XMMATRIX.
-struct Float4x4 {
-    std::array<std::array<float, 4>, 4> m{};
-};
-static_assert(sizeof(Float4x4) == 64);
+using procedural::Float4x4;  // procedural/sample_layout.h
 
 // engine/Payloads.h. `hit` is an HLSL bool, i.e. a 32-bit value.
 struct RayPayload {
