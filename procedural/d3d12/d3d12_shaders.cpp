@@ -72,18 +72,20 @@ std::vector<std::string> aabbHitGroupNames() {
 
 // ---- Pure helpers ----------------------------------------------------------------------------------
 
-vec4 mul(const vec4& v, const Float4x4& M) {
-    vec4 r;
-    for (int j = 0; j < 4; ++j) r[j] = v.x * M.m[0][j] + v.y * M.m[1][j] + v.z * M.m[2][j] + v.w * M.m[3][j];
-    return r;
-}
-
 namespace {
 
+template <typename T>
+using tvec2 = math::vec2<T>;
+template <typename T>
+using tvec3 = math::vec3<T>;
+template <typename T>
+using tvec4 = math::vec4<T>;
+
 // mul(v, (float3x3)M): the upper-left 3x3 of a row-major matrix, row vector on the left.
-vec3 mul3x3(const vec3& v, const Float4x4& M) {
-    vec3 r;
-    for (int j = 0; j < 3; ++j) r[j] = v.x * M.m[0][j] + v.y * M.m[1][j] + v.z * M.m[2][j];
+template <typename T>
+tvec3<T> mul3x3(const tvec3<T>& v, const Float4x4& M) {
+    tvec3<T> r;
+    for (int j = 0; j < 3; ++j) r[j] = v.x * T(M.m[0][j]) + v.y * T(M.m[1][j]) + v.z * T(M.m[2][j]);
     return r;
 }
 
@@ -93,10 +95,6 @@ uint32_t loadDword(const uint8_t* data, size_t sizeInBytes, uint32_t offset) {
     if (uint64_t(offset) + 4 <= sizeInBytes) std::memcpy(&value, data + offset, 4);
     return value;
 }
-
-}  // namespace
-
-namespace {
 
 // The index triplet inside the 8 bytes Load2 read at the dword-aligned offset.
 uvec3 unpack3x16BitIndices(uint32_t offsetBytes, uvec2 four16BitIndices) {
@@ -122,107 +120,142 @@ uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t si
                                                    loadDword(indices, sizeInBytes, dwordAlignedOffset + 4)));
 }
 
-void GenerateCameraRay(uvec2 index, uvec2 dimensions, vec3 cameraPosition, const Float4x4& projectionToWorld,
-                       vec3& origin, vec3& direction) {
-    const vec2 xy = vec2(index) + 0.5f;
-    vec2 screenPos = xy / vec2(dimensions) * 2.0f - 1.0f;
+template <typename T>
+tvec4<T> mul(const tvec4<T>& v, const Float4x4& M) {
+    tvec4<T> r;
+    for (int j = 0; j < 4; ++j)
+        r[j] = v.x * T(M.m[0][j]) + v.y * T(M.m[1][j]) + v.z * T(M.m[2][j]) + v.w * T(M.m[3][j]);
+    return r;
+}
+
+template <typename T>
+void GenerateCameraRay(uvec2 index, uvec2 dimensions, tvec3<T> cameraPosition, const Float4x4& projectionToWorld,
+                       tvec3<T>& origin, tvec3<T>& direction) {
+    const tvec2<T> xy = tvec2<T>(index) + T(0.5f);
+    tvec2<T> screenPos = xy / tvec2<T>(dimensions) * T(2) - T(1);
     screenPos.y = -screenPos.y;
-    vec4 world = mul(vec4(screenPos, 0.0f, 1.0f), projectionToWorld);
-    const vec3 worldXYZ = vec3(world) / world.w;
+    const tvec4<T> world = mul(tvec4<T>(screenPos, T(0), T(1)), projectionToWorld);
+    const tvec3<T> worldXYZ = tvec3<T>(world) / world.w;
     origin = cameraPosition;
     direction = hlsl::normalize(worldXYZ - origin);
 }
 
-vec3 FresnelReflectanceSchlick(vec3 I, vec3 N, vec3 f0) {
-    const float cosi = hlsl::saturate(hlsl::dot(-I, N));
-    return f0 + (1.0f - f0) * hlsl::pow(1.0f - cosi, 5.0f);
+template <typename T>
+tvec3<T> FresnelReflectanceSchlick(tvec3<T> I, tvec3<T> N, tvec3<T> f0) {
+    const T cosi = hlsl::saturate(hlsl::dot(-I, N));
+    return f0 + (T(1) - f0) * hlsl::pow(T(1) - cosi, T(5));
 }
 
-float CheckersTextureBoxFilter(vec2 uv, vec2 dpdx, vec2 dpdy, uint32_t ratio) {
-    const float fRatio = float(ratio);
-    const vec2 w = hlsl::max(hlsl::abs(dpdx), hlsl::abs(dpdy));  // filter kernel
-    const vec2 a = uv + 0.5f * w;
-    const vec2 b = uv - 0.5f * w;
+template <typename T>
+T CheckersTextureBoxFilter(tvec2<T> uv, tvec2<T> dpdx, tvec2<T> dpdy, uint32_t ratio) {
+    const T fRatio = T(ratio);
+    const tvec2<T> w = hlsl::max(hlsl::abs(dpdx), hlsl::abs(dpdy));  // filter kernel
+    const tvec2<T> a = uv + T(0.5f) * w;
+    const tvec2<T> b = uv - T(0.5f) * w;
 
     // Analytical integral (box filter), per component.
-    vec2 i;
+    tvec2<T> i;
     for (glm::length_t k = 0; k < 2; ++k)
-        i[k] = (hlsl::floor(a[k]) + hlsl::min(hlsl::frac(a[k]) * fRatio, 1.0f) - hlsl::floor(b[k]) -
-                hlsl::min(hlsl::frac(b[k]) * fRatio, 1.0f)) /
+        i[k] = (hlsl::floor(a[k]) + hlsl::min(hlsl::frac(a[k]) * fRatio, T(1)) - hlsl::floor(b[k]) -
+                hlsl::min(hlsl::frac(b[k]) * fRatio, T(1))) /
                (fRatio * w[k]);
-    return (1.0f - i.x) * (1.0f - i.y);
+    return (T(1) - i.x) * (T(1) - i.y);
 }
 
-void CalculateRayDifferentials(vec2& ddx_uv, vec2& ddy_uv, vec2 uv, vec3 hitPosition, vec3 surfaceNormal,
-                               vec3 cameraPosition, const Float4x4& projectionToWorld, uvec2 dispatchRaysIndex,
-                               uvec2 dispatchRaysDimensions) {
+template <typename T>
+void CalculateRayDifferentials(tvec2<T>& ddx_uv, tvec2<T>& ddy_uv, tvec2<T> uv, tvec3<T> hitPosition,
+                               tvec3<T> surfaceNormal, tvec3<T> cameraPosition, const Float4x4& projectionToWorld,
+                               uvec2 dispatchRaysIndex, uvec2 dispatchRaysDimensions) {
     // Intersect the neighbouring pixels' primary rays with the tangent plane of the surface.
-    vec3 ddxOrigin, ddxDirection, ddyOrigin, ddyDirection;
+    tvec3<T> ddxOrigin, ddxDirection, ddyOrigin, ddyDirection;
     GenerateCameraRay(dispatchRaysIndex + uvec2(1, 0), dispatchRaysDimensions, cameraPosition, projectionToWorld,
                       ddxOrigin, ddxDirection);
     GenerateCameraRay(dispatchRaysIndex + uvec2(0, 1), dispatchRaysDimensions, cameraPosition, projectionToWorld,
                       ddyOrigin, ddyDirection);
 
-    const vec3 ddx_pos = ddxOrigin - ddxDirection * hlsl::dot(ddxOrigin - hitPosition, surfaceNormal) /
-                                         hlsl::dot(ddxDirection, surfaceNormal);
-    const vec3 ddy_pos = ddyOrigin - ddyDirection * hlsl::dot(ddyOrigin - hitPosition, surfaceNormal) /
-                                         hlsl::dot(ddyDirection, surfaceNormal);
+    const tvec3<T> ddx_pos = ddxOrigin - ddxDirection * hlsl::dot(ddxOrigin - hitPosition, surfaceNormal) /
+                                             hlsl::dot(ddxDirection, surfaceNormal);
+    const tvec3<T> ddy_pos = ddyOrigin - ddyDirection * hlsl::dot(ddyOrigin - hitPosition, surfaceNormal) /
+                                             hlsl::dot(ddyDirection, surfaceNormal);
 
     // TexCoords(position) = position.xz.
-    ddx_uv = vec2(ddx_pos.x, ddx_pos.z) - uv;
-    ddy_uv = vec2(ddy_pos.x, ddy_pos.z) - uv;
+    ddx_uv = tvec2<T>(ddx_pos.x, ddx_pos.z) - uv;
+    ddy_uv = tvec2<T>(ddy_pos.x, ddy_pos.z) - uv;
 }
 
-float AnalyticalCheckersTexture(vec3 hitPosition, vec3 surfaceNormal, vec3 cameraPosition,
-                                const Float4x4& projectionToWorld, uvec2 dispatchRaysIndex,
-                                uvec2 dispatchRaysDimensions) {
-    vec2 ddx_uv, ddy_uv;
-    const vec2 uv(hitPosition.x, hitPosition.z);
+template <typename T>
+T AnalyticalCheckersTexture(tvec3<T> hitPosition, tvec3<T> surfaceNormal, tvec3<T> cameraPosition,
+                            const Float4x4& projectionToWorld, uvec2 dispatchRaysIndex, uvec2 dispatchRaysDimensions) {
+    tvec2<T> ddx_uv, ddy_uv;
+    const tvec2<T> uv(hitPosition.x, hitPosition.z);
     CalculateRayDifferentials(ddx_uv, ddy_uv, uv, hitPosition, surfaceNormal, cameraPosition, projectionToWorld,
                               dispatchRaysIndex, dispatchRaysDimensions);
     return CheckersTextureBoxFilter(uv, ddx_uv, ddy_uv, 50);
 }
 
-vec4 CalculatePhongLighting(const SceneConstantBuffer& sceneCB, vec4 albedo, vec3 normal, bool isInShadow,
-                            float diffuseCoef, float specularCoef, float specularPower, vec3 hitPosition,
-                            vec3 worldRayDirection) {
-    const vec3 lightPosition = vec3(sceneCB.lightPosition);
-    const float shadowFactor = isInShadow ? InShadowRadiance : 1.0f;
-    const vec3 incidentLightRay = hlsl::normalize(hitPosition - lightPosition);
+template <typename T>
+tvec4<T> CalculatePhongLighting(const SceneConstantBuffer& sceneCB, tvec4<T> albedo, tvec3<T> normal, bool isInShadow,
+                                T diffuseCoef, T specularCoef, T specularPower, tvec3<T> hitPosition,
+                                tvec3<T> worldRayDirection) {
+    const tvec3<T> lightPosition = tvec3<T>(vec3(sceneCB.lightPosition));
+    const T shadowFactor = isInShadow ? T(InShadowRadiance) : T(1);
+    const tvec3<T> incidentLightRay = hlsl::normalize(hitPosition - lightPosition);
 
     // Diffuse component.
-    const vec4 lightDiffuseColor = sceneCB.lightDiffuseColor;
-    const float Kd = hlsl::saturate(hlsl::dot(-incidentLightRay, normal));
-    const vec4 diffuseColor = shadowFactor * diffuseCoef * Kd * lightDiffuseColor * albedo;
+    const tvec4<T> lightDiffuseColor = tvec4<T>(sceneCB.lightDiffuseColor);
+    const T Kd = hlsl::saturate(hlsl::dot(-incidentLightRay, normal));
+    const tvec4<T> diffuseColor = shadowFactor * diffuseCoef * Kd * lightDiffuseColor * albedo;
 
     // Specular component.
-    vec4 specularColor(0.0f);
+    tvec4<T> specularColor(T(0));
     if (!isInShadow) {
-        const vec4 lightSpecularColor(1.0f);
-        const vec3 reflectedLightRay = hlsl::normalize(hlsl::reflect(incidentLightRay, normal));
-        const float Ks =
-            hlsl::pow(hlsl::saturate(hlsl::dot(reflectedLightRay, hlsl::normalize(-worldRayDirection))), specularPower);
+        const tvec4<T> lightSpecularColor(T(1));
+        const tvec3<T> reflectedLightRay = hlsl::normalize(hlsl::reflect(incidentLightRay, normal));
+        const T Ks = hlsl::pow(hlsl::saturate(hlsl::dot(reflectedLightRay, hlsl::normalize(-worldRayDirection))),
+                               specularPower);
         specularColor = specularCoef * Ks * lightSpecularColor;
     }
 
     // Ambient component, with the fake AO that darkens faces turned towards -y.
-    const vec4 ambientColorMin = sceneCB.lightAmbientColor - 0.1f;
-    const vec4 ambientColorMax = sceneCB.lightAmbientColor;
-    const float a = 1.0f - hlsl::saturate(hlsl::dot(normal, vec3(0.0f, -1.0f, 0.0f)));
-    const vec4 ambientColor = albedo * hlsl::lerp(ambientColorMin, ambientColorMax, a);
+    const tvec4<T> ambientColorMin = tvec4<T>(sceneCB.lightAmbientColor) - T(0.1f);
+    const tvec4<T> ambientColorMax = tvec4<T>(sceneCB.lightAmbientColor);
+    const T a = T(1) - hlsl::saturate(hlsl::dot(normal, tvec3<T>(T(0), T(-1), T(0))));
+    const tvec4<T> ambientColor = albedo * hlsl::lerp(ambientColorMin, ambientColorMax, a);
 
     return ambientColor + diffuseColor + specularColor;
 }
 
-vec4 ApplyVisibilityFalloff(vec4 color, float t) {
-    return hlsl::lerp(color, BackgroundColor, 1.0f - hlsl::exp(-0.000002f * t * t * t));
+template <typename T>
+tvec4<T> ApplyVisibilityFalloff(tvec4<T> color, T t) {
+    return hlsl::lerp(color, tvec4<T>(BackgroundColor), T(1) - hlsl::exp(T(-0.000002f) * t * t * t));
 }
+
+#define REFRAY_INSTANTIATE_HELPERS(T)                                                                               \
+    template tvec4<T> mul<T>(const tvec4<T>&, const Float4x4&);                                                     \
+    template void GenerateCameraRay<T>(uvec2, uvec2, tvec3<T>, const Float4x4&, tvec3<T>&, tvec3<T>&);             \
+    template tvec3<T> FresnelReflectanceSchlick<T>(tvec3<T>, tvec3<T>, tvec3<T>);                                  \
+    template T CheckersTextureBoxFilter<T>(tvec2<T>, tvec2<T>, tvec2<T>, uint32_t);                                 \
+    template void CalculateRayDifferentials<T>(tvec2<T>&, tvec2<T>&, tvec2<T>, tvec3<T>, tvec3<T>, tvec3<T>,        \
+                                               const Float4x4&, uvec2, uvec2);                                      \
+    template T AnalyticalCheckersTexture<T>(tvec3<T>, tvec3<T>, tvec3<T>, const Float4x4&, uvec2, uvec2);           \
+    template tvec4<T> CalculatePhongLighting<T>(const SceneConstantBuffer&, tvec4<T>, tvec3<T>, bool, T, T, T,      \
+                                                tvec3<T>, tvec3<T>);                                                \
+    template tvec4<T> ApplyVisibilityFalloff<T>(tvec4<T>, T);
+REFRAY_INSTANTIATE_HELPERS(float)
+REFRAY_INSTANTIATE_HELPERS(double)
+#undef REFRAY_INSTANTIATE_HELPERS
 
 // ---- Shader-side helpers (Raytracing.hlsl) ---------------------------------------------------------
 
 namespace {
 
-using hlsl::ScopedFlushDenormals;
+// Float mode runs with denormals flushed, as D3D float32 arithmetic does; the double oracle keeps them.
+template <typename T>
+struct PrecisionScope {};
+template <>
+struct PrecisionScope<float> {
+    hlsl::ScopedFlushDenormals ftz;
+};
 
 SceneConstantBuffer sceneCB(const ShaderContext& ctx) {
     return ctx.load<SceneConstantBuffer>(ctx.globalRootDescriptor(kSceneConstant));
@@ -243,52 +276,61 @@ PrimitiveInstancePerFrameBuffer primitiveAttributes(const ShaderContext& ctx) {
     return ctx.load<PrimitiveInstancePerFrameBuffer>(element);
 }
 
-vec3 HitWorldPosition(const ShaderContext& ctx) {
-    return ctx.WorldRayOrigin() + ctx.RayTCurrent() * ctx.WorldRayDirection();
+template <typename T>
+tvec3<T> HitWorldPosition(const ShaderContext& ctx) {
+    return tvec3<T>(ctx.WorldRayOrigin()) + T(ctx.RayTCurrent()) * tvec3<T>(ctx.WorldRayDirection());
 }
 
 // The object ray in the primitive's local space. The direction is not renormalised, so t means the same in world,
 // object and local space (§2.2).
-math::Ray<float> GetRayInAABBPrimitiveLocalSpace(const ShaderContext& ctx, const PrimitiveInstancePerFrameBuffer& attr) {
-    math::Ray<float> ray;
-    ray.origin = vec3(mul(vec4(ctx.ObjectRayOrigin(), 1.0f), attr.bottomLevelASToLocalSpace));
-    ray.direction = mul3x3(ctx.ObjectRayDirection(), attr.bottomLevelASToLocalSpace);
+template <typename T>
+math::Ray<T> GetRayInAABBPrimitiveLocalSpace(const ShaderContext& ctx, const PrimitiveInstancePerFrameBuffer& attr) {
+    math::Ray<T> ray;
+    ray.origin = tvec3<T>(mul(tvec4<T>(tvec3<T>(ctx.ObjectRayOrigin()), T(1)), attr.bottomLevelASToLocalSpace));
+    ray.direction = mul3x3(tvec3<T>(ctx.ObjectRayDirection()), attr.bottomLevelASToLocalSpace);
     return ray;
 }
 
 // mul(n, (float3x3)localSpaceToBottomLevelAS), then normalize(mul((float3x3)ObjectToWorld3x4(), n)): the forward
 // matrix, not the inverse transpose (I1).
-vec3 NormalToWorld(const ShaderContext& ctx, const PrimitiveInstancePerFrameBuffer& attr, const vec3& localNormal) {
-    const vec3 n = mul3x3(localNormal, attr.localSpaceToBottomLevelAS);
+template <typename T>
+tvec3<T> NormalToWorld(const ShaderContext& ctx, const PrimitiveInstancePerFrameBuffer& attr,
+                       const tvec3<T>& localNormal) {
+    const tvec3<T> n = mul3x3(localNormal, attr.localSpaceToBottomLevelAS);
     const Matrix3x4 o2w = ctx.ObjectToWorld3x4();
-    vec3 r;
-    for (int i = 0; i < 3; ++i) r[i] = o2w.m[i][0] * n.x + o2w.m[i][1] * n.y + o2w.m[i][2] * n.z;
+    tvec3<T> r;
+    for (int i = 0; i < 3; ++i) r[i] = T(o2w.m[i][0]) * n.x + T(o2w.m[i][1]) * n.y + T(o2w.m[i][2]) * n.z;
     return hlsl::normalize(r);
 }
 
 // The sample applies the triangle culling flags to its procedural hits itself (I3).
-math::RayExtent<float> CurrentExtent(const ShaderContext& ctx) {
+template <typename T>
+math::RayExtent<T> CurrentExtent(const ShaderContext& ctx) {
     const uint32_t flags = ctx.RayFlags();
-    return {ctx.RayTMin(), ctx.RayTCurrent(), (flags & RAY_FLAG_CULL_BACK_FACING_TRIANGLES) != 0,
+    return {T(ctx.RayTMin()), T(ctx.RayTCurrent()), (flags & RAY_FLAG_CULL_BACK_FACING_TRIANGLES) != 0,
             (flags & RAY_FLAG_CULL_FRONT_FACING_TRIANGLES) != 0};
 }
 
 // TraceRay wrappers: both stop at MAX_RAY_RECURSION_DEPTH (black / "not in shadow"); TMin 0, TMax 10000.
-vec4 TraceRadianceRay(ShaderContext& ctx, const vec3& origin, const vec3& direction, uint32_t currentRayRecursionDepth) {
-    if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH) return vec4(0.0f);
-    const RayDesc rayDesc{origin, 0.0f, direction, 10000.0f};
+// The RayDesc and the payload are the GPU interface: the ray is rounded to float on the way in.
+template <typename T>
+tvec4<T> TraceRadianceRay(ShaderContext& ctx, const tvec3<T>& origin, const tvec3<T>& direction,
+                          uint32_t currentRayRecursionDepth) {
+    if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH) return tvec4<T>(T(0));
+    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     RayPayload rayPayload{vec4(0.0f), currentRayRecursionDepth + 1};
     ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_CULL_BACK_FACING_TRIANGLES,
                  TraceRayParameters::InstanceMask, /*HitGroup::Offset*/ RayType::Radiance,
                  TraceRayParameters::GeometryStride, /*MissShader::Offset*/ RayType::Radiance, rayDesc, rayPayload);
-    return rayPayload.color;
+    return tvec4<T>(rayPayload.color);
 }
 
-bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const vec3& origin, const vec3& direction,
+template <typename T>
+bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const tvec3<T>& origin, const tvec3<T>& direction,
                                   uint32_t currentRayRecursionDepth) {
     if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH) return false;
     // TMax 10000, not the distance to the light (I2).
-    const RayDesc rayDesc{origin, 0.0f, direction, 10000.0f};
+    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     // Starts as "hit": closest-hit and any-hit shaders are skipped, only MyMissShader_ShadowRay clears it.
     ShadowRayPayload shadowPayload{1};
     ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure),
@@ -300,40 +342,46 @@ bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const vec3& origin, const 
 }
 
 // The shadow ray both closest hits start with: from HitWorldPosition() towards the light.
+template <typename T>
 bool TraceShadowRayTowardsLight(ShaderContext& ctx, const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth) {
-    const vec3 hitPosition = HitWorldPosition(ctx);
-    return TraceShadowRayAndReportIfHit(ctx, hitPosition, hlsl::normalize(vec3(g_sceneCB.lightPosition) - hitPosition),
-                                        recursionDepth);
+    const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
+    return TraceShadowRayAndReportIfHit(
+        ctx, hitPosition, hlsl::normalize(tvec3<T>(vec3(g_sceneCB.lightPosition)) - hitPosition), recursionDepth);
 }
 
 // reflectanceCoef·(Fresnel, 1)·(reflection ray colour), the reflection ray leaving HitWorldPosition().
-vec4 ReflectedColor(ShaderContext& ctx, const vec3& normal, const PrimitiveConstantBuffer& l_materialCB,
-                    uint32_t recursionDepth) {
-    const vec4 reflectionColor =
-        TraceRadianceRay(ctx, HitWorldPosition(ctx), hlsl::reflect(ctx.WorldRayDirection(), normal), recursionDepth);
-    const vec3 fresnelR = FresnelReflectanceSchlick(ctx.WorldRayDirection(), normal, vec3(l_materialCB.albedo));
-    return l_materialCB.reflectanceCoef * vec4(fresnelR, 1.0f) * reflectionColor;
+template <typename T>
+tvec4<T> ReflectedColor(ShaderContext& ctx, const tvec3<T>& normal, const PrimitiveConstantBuffer& l_materialCB,
+                        uint32_t recursionDepth) {
+    const tvec3<T> D = tvec3<T>(ctx.WorldRayDirection());
+    const tvec4<T> reflectionColor =
+        TraceRadianceRay(ctx, HitWorldPosition<T>(ctx), hlsl::reflect(D, normal), recursionDepth);
+    const tvec3<T> fresnelR = FresnelReflectanceSchlick(D, normal, tvec3<T>(vec3(l_materialCB.albedo)));
+    return T(l_materialCB.reflectanceCoef) * tvec4<T>(fresnelR, T(1)) * reflectionColor;
 }
 
 // ---- Entry points ----------------------------------------------------------------------------------
+// Each is a template on the scalar type; results are rounded to float where they cross the interface.
 
+template <typename T>
 void MyRaygenShader(ShaderContext& ctx) {
-    ScopedFlushDenormals ftz;
+    [[maybe_unused]] PrecisionScope<T> scope;
     const uvec3 index = ctx.DispatchRaysIndex();
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
-    vec3 origin, direction;
-    GenerateCameraRay(uvec2(index), uvec2(ctx.DispatchRaysDimensions()), vec3(g_sceneCB.cameraPosition),
+    tvec3<T> origin, direction;
+    GenerateCameraRay(uvec2(index), uvec2(ctx.DispatchRaysDimensions()), tvec3<T>(vec3(g_sceneCB.cameraPosition)),
                       g_sceneCB.projectionToWorld, origin, direction);
     const uint32_t currentRecursionDepth = 0;
-    const vec4 color = TraceRadianceRay(ctx, origin, direction, currentRecursionDepth);
+    const tvec4<T> color = TraceRadianceRay(ctx, origin, direction, currentRecursionDepth);
     // PORT: the texture stores floats; the R8G8B8A8_UNORM conversion (clamp, round, NaN -> 0) happens when the
     // image is written out (H20).
-    ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView)).at(index.x, index.y) = color;
+    ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView)).at(index.x, index.y) = vec4(color);
 }
 
+template <typename T>
 void MyClosestHitShader_Triangle(ShaderContext& ctx, RayPayload& rayPayload,
                                  const BuiltInTriangleIntersectionAttributes&) {
-    ScopedFlushDenormals ftz;
+    [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
 
@@ -346,48 +394,50 @@ void MyClosestHitShader_Triangle(ShaderContext& ctx, RayPayload& rayPayload,
     const GpuDescriptorHandle vertexBuffers = ctx.globalDescriptorTable(kVertexBuffers);
     const uvec3 indices = unpack3x16BitIndices(
         baseIndex, ctx.loadFromTable<uvec2>(vertexBuffers, /*g_indices*/ 0, /*Load2 at*/ baseIndex & ~3u));
-    const vec3 triangleNormal =
-        ctx.loadFromTable<Vertex>(vertexBuffers, /*g_vertices*/ 1, uint64_t(indices[0]) * sizeof(Vertex)).normal;
+    const tvec3<T> triangleNormal = tvec3<T>(
+        ctx.loadFromTable<Vertex>(vertexBuffers, /*g_vertices*/ 1, uint64_t(indices[0]) * sizeof(Vertex)).normal);
 
     // Shadow component.
-    const bool shadowRayHit = TraceShadowRayTowardsLight(ctx, g_sceneCB, rayPayload.recursionDepth);
+    const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, g_sceneCB, rayPayload.recursionDepth);
 
     // Grid lines from the primary camera rays' footprint, even for secondary hits (I7, H4).
-    const float checkers = AnalyticalCheckersTexture(
-        HitWorldPosition(ctx), triangleNormal, vec3(g_sceneCB.cameraPosition), g_sceneCB.projectionToWorld,
-        uvec2(ctx.DispatchRaysIndex()), uvec2(ctx.DispatchRaysDimensions()));
+    const T checkers = AnalyticalCheckersTexture(
+        HitWorldPosition<T>(ctx), triangleNormal, tvec3<T>(vec3(g_sceneCB.cameraPosition)),
+        g_sceneCB.projectionToWorld, uvec2(ctx.DispatchRaysIndex()), uvec2(ctx.DispatchRaysDimensions()));
 
     // Reflected component.
-    vec4 reflectedColor(0.0f);
+    tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
         reflectedColor = ReflectedColor(ctx, triangleNormal, l_materialCB, rayPayload.recursionDepth);
 
     // Final colour, then the visibility falloff.
-    const vec4 phongColor = CalculatePhongLighting(g_sceneCB, l_materialCB.albedo, triangleNormal, shadowRayHit,
-                                                   l_materialCB.diffuseCoef, l_materialCB.specularCoef,
-                                                   l_materialCB.specularPower, HitWorldPosition(ctx),
-                                                   ctx.WorldRayDirection());
-    const vec4 color = checkers * (phongColor + reflectedColor);
-    rayPayload.color = ApplyVisibilityFalloff(color, ctx.RayTCurrent());
+    const tvec4<T> phongColor = CalculatePhongLighting(
+        g_sceneCB, tvec4<T>(l_materialCB.albedo), triangleNormal, shadowRayHit, T(l_materialCB.diffuseCoef),
+        T(l_materialCB.specularCoef), T(l_materialCB.specularPower), HitWorldPosition<T>(ctx),
+        tvec3<T>(ctx.WorldRayDirection()));
+    const tvec4<T> color = checkers * (phongColor + reflectedColor);
+    rayPayload.color = vec4(ApplyVisibilityFalloff(color, T(ctx.RayTCurrent())));
 }
 
+template <typename T>
 void MyClosestHitShader_AABB(ShaderContext& ctx, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
-    ScopedFlushDenormals ftz;
+    [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
+    const tvec3<T> normal = tvec3<T>(attr.normal);
 
-    const bool shadowRayHit = TraceShadowRayTowardsLight(ctx, g_sceneCB, rayPayload.recursionDepth);
+    const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, g_sceneCB, rayPayload.recursionDepth);
 
-    vec4 reflectedColor(0.0f);
+    tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, attr.normal, l_materialCB, rayPayload.recursionDepth);
+        reflectedColor = ReflectedColor(ctx, normal, l_materialCB, rayPayload.recursionDepth);
 
-    const vec4 phongColor = CalculatePhongLighting(g_sceneCB, l_materialCB.albedo, attr.normal, shadowRayHit,
-                                                   l_materialCB.diffuseCoef, l_materialCB.specularCoef,
-                                                   l_materialCB.specularPower, HitWorldPosition(ctx),
-                                                   ctx.WorldRayDirection());
-    const vec4 color = phongColor + reflectedColor;
-    rayPayload.color = ApplyVisibilityFalloff(color, ctx.RayTCurrent());
+    const tvec4<T> phongColor = CalculatePhongLighting(
+        g_sceneCB, tvec4<T>(l_materialCB.albedo), normal, shadowRayHit, T(l_materialCB.diffuseCoef),
+        T(l_materialCB.specularCoef), T(l_materialCB.specularPower), HitWorldPosition<T>(ctx),
+        tvec3<T>(ctx.WorldRayDirection()));
+    const tvec4<T> color = phongColor + reflectedColor;
+    rayPayload.color = vec4(ApplyVisibilityFalloff(color, T(ctx.RayTCurrent())));
 }
 
 void MyMissShader(ShaderContext&, RayPayload& rayPayload) { rayPayload.color = BackgroundColor; }
@@ -395,80 +445,100 @@ void MyMissShader(ShaderContext&, RayPayload& rayPayload) { rayPayload.color = B
 void MyMissShader_ShadowRay(ShaderContext&, ShadowRayPayload& rayPayload) { rayPayload.hit = 0; }
 
 // Each intersection shader starts from zero-initialised attributes (H6) and reports HitKind 0 with the world normal.
+template <typename T>
 void MyIntersectionShader_AnalyticPrimitive(ShaderContext& ctx) {
-    ScopedFlushDenormals ftz;
+    [[maybe_unused]] PrecisionScope<T> scope;
     const PrimitiveInstancePerFrameBuffer aabbAttribute = primitiveAttributes(ctx);
-    const math::Ray<float> localRay = GetRayInAABBPrimitiveLocalSpace(ctx, aabbAttribute);
+    const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx, aabbAttribute);
     const auto primitiveType = AnalyticPrimitive::Enum(aabbCB(ctx).primitiveType);
-    const math::RayExtent<float> extent = CurrentExtent(ctx);
+    const math::RayExtent<T> extent = CurrentExtent<T>(ctx);
 
     // RayAnalyticGeometryIntersectionTest: the local box is <-1,1>^3.
-    math::AnalyticHit<float> test;
+    math::AnalyticHit<T> test;
     switch (primitiveType) {
         case AnalyticPrimitive::AABB: test = math::RayUnitCubeIntersectionTest(localRay, extent); break;
         case AnalyticPrimitive::Spheres: test = math::RaySpheresIntersectionTest(localRay, extent); break;
         default: break;
     }
     if (test.hit) {
-        const ProceduralPrimitiveAttributes attr{NormalToWorld(ctx, aabbAttribute, test.normal)};
-        ctx.ReportHit(test.thit, /*hitKind*/ 0, attr);
+        const ProceduralPrimitiveAttributes attr{vec3(NormalToWorld(ctx, aabbAttribute, test.normal))};
+        ctx.ReportHit(float(test.thit), /*hitKind*/ 0, attr);
     }
 }
 
+template <typename T>
 void MyIntersectionShader_VolumetricPrimitive(ShaderContext& ctx) {
-    ScopedFlushDenormals ftz;
+    [[maybe_unused]] PrecisionScope<T> scope;
     const PrimitiveInstancePerFrameBuffer aabbAttribute = primitiveAttributes(ctx);
-    const math::Ray<float> localRay = GetRayInAABBPrimitiveLocalSpace(ctx, aabbAttribute);
+    const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx, aabbAttribute);
     const auto primitiveType = VolumetricPrimitive::Enum(aabbCB(ctx).primitiveType);
-    const float elapsedTime = sceneCB(ctx).elapsedTime;
+    const T elapsedTime = T(sceneCB(ctx).elapsedTime);
 
     // RayVolumetricGeometryIntersectionTest: metaballs animated over a 12 s cycle. The march step depends on
     // RayTCurrent() at call time (H10).
-    math::MetaballsHit<float> test;
+    math::MetaballsHit<T> test;
     if (primitiveType == VolumetricPrimitive::Metaballs)
-        test = math::RayMetaballsIntersectionTest(localRay, CurrentExtent(ctx), elapsedTime, 12.0f);
+        test = math::RayMetaballsIntersectionTest(localRay, CurrentExtent<T>(ctx), elapsedTime, T(12));
     if (test.hit) {
-        const ProceduralPrimitiveAttributes attr{NormalToWorld(ctx, aabbAttribute, test.normal)};
-        ctx.ReportHit(test.thit, /*hitKind*/ 0, attr);
+        const ProceduralPrimitiveAttributes attr{vec3(NormalToWorld(ctx, aabbAttribute, test.normal))};
+        ctx.ReportHit(float(test.thit), /*hitKind*/ 0, attr);
     }
 }
 
+template <typename T>
 void MyIntersectionShader_SignedDistancePrimitive(ShaderContext& ctx) {
-    ScopedFlushDenormals ftz;
+    [[maybe_unused]] PrecisionScope<T> scope;
     const PrimitiveInstancePerFrameBuffer aabbAttribute = primitiveAttributes(ctx);
-    const math::Ray<float> localRay = GetRayInAABBPrimitiveLocalSpace(ctx, aabbAttribute);
+    const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx, aabbAttribute);
     const auto primitiveType = SignedDistancePrimitive(aabbCB(ctx).primitiveType);
 
     // RaySignedDistancePrimitiveTest: sphere tracing from RayTMin(), not from the box entry (I6).
-    math::SphereTraceParams<float> params;
-    params.stepScale = materialCB(ctx).stepScale;
-    const auto sdf = [primitiveType](const vec3& position) {
+    math::SphereTraceParams<T> params;
+    params.stepScale = T(materialCB(ctx).stepScale);
+    const auto sdf = [primitiveType](const tvec3<T>& position) {
         return math::d3d12::GetDistanceFromSignedDistancePrimitive(position, primitiveType);
     };
-    const math::SphereTraceResult<float> test =
-        math::RaySignedDistancePrimitiveTest(localRay, CurrentExtent(ctx), sdf, params);
+    const math::SphereTraceResult<T> test =
+        math::RaySignedDistancePrimitiveTest(localRay, CurrentExtent<T>(ctx), sdf, params);
     if (test.hit) {
-        const ProceduralPrimitiveAttributes attr{NormalToWorld(ctx, aabbAttribute, test.normal)};
-        ctx.ReportHit(test.thit, /*hitKind*/ 0, attr);
+        const ProceduralPrimitiveAttributes attr{vec3(NormalToWorld(ctx, aabbAttribute, test.normal))};
+        ctx.ReportHit(float(test.thit), /*hitKind*/ 0, attr);
     }
+}
+
+// Every export, with its math in T.
+template <typename T>
+void addExports(ShaderLibrary& lib) {
+    lib.addRayGeneration("MyRaygenShader", [](ShaderContext& ctx) { MyRaygenShader<T>(ctx); });
+    lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
+        "MyClosestHitShader_Triangle",
+        [](ShaderContext& ctx, RayPayload& payload, const BuiltInTriangleIntersectionAttributes& attr) {
+            MyClosestHitShader_Triangle<T>(ctx, payload, attr);
+        });
+    lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
+        "MyClosestHitShader_AABB",
+        [](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
+            MyClosestHitShader_AABB<T>(ctx, payload, attr);
+        });
+    lib.addMiss<RayPayload>("MyMissShader", MyMissShader);
+    lib.addMiss<ShadowRayPayload>("MyMissShader_ShadowRay", MyMissShader_ShadowRay);
+    lib.addIntersection<ProceduralPrimitiveAttributes>(
+        "MyIntersectionShader_AnalyticPrimitive",
+        [](ShaderContext& ctx) { MyIntersectionShader_AnalyticPrimitive<T>(ctx); });
+    lib.addIntersection<ProceduralPrimitiveAttributes>(
+        "MyIntersectionShader_VolumetricPrimitive",
+        [](ShaderContext& ctx) { MyIntersectionShader_VolumetricPrimitive<T>(ctx); });
+    lib.addIntersection<ProceduralPrimitiveAttributes>(
+        "MyIntersectionShader_SignedDistancePrimitive",
+        [](ShaderContext& ctx) { MyIntersectionShader_SignedDistancePrimitive<T>(ctx); });
 }
 
 }  // namespace
 
-std::shared_ptr<ShaderLibrary> makeD3D12ShaderLibrary() {
+std::shared_ptr<ShaderLibrary> makeD3D12ShaderLibrary(Precision precision) {
     auto lib = std::make_shared<ShaderLibrary>();
-    lib->addRayGeneration("MyRaygenShader", MyRaygenShader);
-    lib->addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>("MyClosestHitShader_Triangle",
-                                                                          MyClosestHitShader_Triangle);
-    lib->addClosestHit<RayPayload, ProceduralPrimitiveAttributes>("MyClosestHitShader_AABB", MyClosestHitShader_AABB);
-    lib->addMiss<RayPayload>("MyMissShader", MyMissShader);
-    lib->addMiss<ShadowRayPayload>("MyMissShader_ShadowRay", MyMissShader_ShadowRay);
-    lib->addIntersection<ProceduralPrimitiveAttributes>("MyIntersectionShader_AnalyticPrimitive",
-                                                        MyIntersectionShader_AnalyticPrimitive);
-    lib->addIntersection<ProceduralPrimitiveAttributes>("MyIntersectionShader_VolumetricPrimitive",
-                                                        MyIntersectionShader_VolumetricPrimitive);
-    lib->addIntersection<ProceduralPrimitiveAttributes>("MyIntersectionShader_SignedDistancePrimitive",
-                                                        MyIntersectionShader_SignedDistancePrimitive);
+    if (precision == Precision::Double) addExports<double>(*lib);
+    else addExports<float>(*lib);
     return lib;
 }
 

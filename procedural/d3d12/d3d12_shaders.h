@@ -7,6 +7,11 @@
 // shadow, Fresnel reflection, box-filtered analytic grid from ray differentials, fog), the AABB closest hit, and the
 // three intersection shaders (analytic box and spheres, animated metaballs, seven sphere-traced SDFs). The pure math
 // lives in procedural/math/; the entry points here transform the ray, call it, shade and TraceRay as the HLSL does.
+//
+// Precision (issue 3): the shader-internal math (local ray, analytic / volumetric / SDF intersections, normals, grid
+// filter, lighting, fog) runs in T = float or double. The structs below are the GPU interface and stay float; values
+// are rounded to float where they cross it (ReportHit's t, attributes, payload colour, RayDesc, the render target).
+// HLSL literals are float, so double mode uses their float values. Float mode flushes denormals; double does not.
 #pragma once
 
 #include <array>
@@ -20,6 +25,7 @@
 #include "emulator/state_object.h"
 #include "procedural/sample_layout.h"
 #include "procedural/math/fractals.h"
+#include "procedural/precision.h"
 
 namespace refray::procedural::d3d12 {
 
@@ -168,7 +174,8 @@ std::vector<std::string> aabbHitGroupNames();
 // Exports, with their HLSL names: MyRaygenShader, MyClosestHitShader_Triangle, MyClosestHitShader_AABB, MyMissShader,
 // MyMissShader_ShadowRay, MyIntersectionShader_AnalyticPrimitive, MyIntersectionShader_VolumetricPrimitive,
 // MyIntersectionShader_SignedDistancePrimitive.
-std::shared_ptr<dxr::ShaderLibrary> makeD3D12ShaderLibrary();
+// PORT: `precision` selects the scalar type of the shader-internal math (Precision::Double is not the GPU's).
+std::shared_ptr<dxr::ShaderLibrary> makeD3D12ShaderLibrary(Precision precision = Precision::Float);
 
 // ---- The ground plane's index and vertex buffers (§1.2) ----------------------------------------------
 // What the app uploads as g_indices (6 16-bit indices, a raw view) and g_vertices (4 vertices, stride 24), which
@@ -179,43 +186,53 @@ extern const std::array<Vertex, 4> kPlaneVertices;
 // ---- Pure helpers of the entry points, exposed for tests ---------------------------------------------
 // PORT: intrinsics these helpers read in HLSL (DispatchRaysIndex/Dimensions, WorldRayDirection) are parameters.
 
-// mul(v, M) for a row vector, summed in row order.
-vec4 mul(const vec4& v, const Float4x4& M);
-
-// GenerateCameraRay: pixel centre, y flipped, unprojected with mul(float4(s, t, 0, 1), projectionToWorld), divided
-// by w; origin = cameraPosition, direction normalised (§2.1).
-void GenerateCameraRay(uvec2 index, uvec2 dimensions, vec3 cameraPosition, const Float4x4& projectionToWorld,
-                       vec3& origin, vec3& direction);
-
 // Load3x16BitIndices: the three 16-bit indices at byte `offsetBytes`, read as two aligned dwords the way a
 // ByteAddressBuffer Load2 does. Dwords past `sizeInBytes` read 0.
 uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t sizeInBytes);
 
+// The helpers below are templates on the scalar type, defined and instantiated (float, double) in the .cpp.
+
+// mul(v, M) for a row vector, summed in row order.
+template <typename T>
+glm::vec<4, T> mul(const glm::vec<4, T>& v, const Float4x4& M);
+
+// GenerateCameraRay: pixel centre, y flipped, unprojected with mul(float4(s, t, 0, 1), projectionToWorld), divided
+// by w; origin = cameraPosition, direction normalised (§2.1).
+template <typename T>
+void GenerateCameraRay(uvec2 index, uvec2 dimensions, glm::vec<3, T> cameraPosition, const Float4x4& projectionToWorld,
+                       glm::vec<3, T>& origin, glm::vec<3, T>& direction);
+
 // FresnelReflectanceSchlick(I, N, f0) = f0 + (1 - f0)·pow(1 - saturate(dot(-I, N)), 5).
-vec3 FresnelReflectanceSchlick(vec3 I, vec3 N, vec3 f0);
+template <typename T>
+glm::vec<3, T> FresnelReflectanceSchlick(glm::vec<3, T> I, glm::vec<3, T> N, glm::vec<3, T> f0);
 
 // CheckersTextureBoxFilter: the grid of lines 1/ratio wide at every integer u and v, box-filtered over
 // w = max(|dpdx|, |dpdy|); 1 on the white cells, 0 on a line (§2.9 step 3).
-float CheckersTextureBoxFilter(vec2 uv, vec2 dpdx, vec2 dpdy, uint32_t ratio);
+template <typename T>
+T CheckersTextureBoxFilter(glm::vec<2, T> uv, glm::vec<2, T> dpdx, glm::vec<2, T> dpdy, uint32_t ratio);
 
 // CalculateRayDifferentials: the primary camera rays of pixels index + (1,0) and index + (0,1) intersected with the
 // plane through hitPosition with normal surfaceNormal; the footprint in uv = position.xz (I7).
-void CalculateRayDifferentials(vec2& ddx_uv, vec2& ddy_uv, vec2 uv, vec3 hitPosition, vec3 surfaceNormal,
-                               vec3 cameraPosition, const Float4x4& projectionToWorld, uvec2 dispatchRaysIndex,
+template <typename T>
+void CalculateRayDifferentials(glm::vec<2, T>& ddx_uv, glm::vec<2, T>& ddy_uv, glm::vec<2, T> uv,
+                               glm::vec<3, T> hitPosition, glm::vec<3, T> surfaceNormal, glm::vec<3, T> cameraPosition,
+                               const Float4x4& projectionToWorld, uvec2 dispatchRaysIndex,
                                uvec2 dispatchRaysDimensions);
 
 // AnalyticalCheckersTexture: CheckersTextureBoxFilter(hitPosition.xz, footprint, 50).
-float AnalyticalCheckersTexture(vec3 hitPosition, vec3 surfaceNormal, vec3 cameraPosition,
-                                const Float4x4& projectionToWorld, uvec2 dispatchRaysIndex,
-                                uvec2 dispatchRaysDimensions);
+template <typename T>
+T AnalyticalCheckersTexture(glm::vec<3, T> hitPosition, glm::vec<3, T> surfaceNormal, glm::vec<3, T> cameraPosition,
+                            const Float4x4& projectionToWorld, uvec2 dispatchRaysIndex, uvec2 dispatchRaysDimensions);
 
 // CalculatePhongLighting: ambient (darkened towards -y) + diffuse (scaled by InShadowRadiance in shadow) + white
 // specular (only when not in shadow, not gated by N·L: I8) for the point light of g_sceneCB (§2.11).
-vec4 CalculatePhongLighting(const SceneConstantBuffer& sceneCB, vec4 albedo, vec3 normal, bool isInShadow,
-                            float diffuseCoef, float specularCoef, float specularPower, vec3 hitPosition,
-                            vec3 worldRayDirection);
+template <typename T>
+glm::vec<4, T> CalculatePhongLighting(const SceneConstantBuffer& sceneCB, glm::vec<4, T> albedo, glm::vec<3, T> normal,
+                                      bool isInShadow, T diffuseCoef, T specularCoef, T specularPower,
+                                      glm::vec<3, T> hitPosition, glm::vec<3, T> worldRayDirection);
 
 // The "visibility falloff" of both closest hits: lerp(color, BackgroundColor, 1 - exp(-0.000002·t³)).
-vec4 ApplyVisibilityFalloff(vec4 color, float t);
+template <typename T>
+glm::vec<4, T> ApplyVisibilityFalloff(glm::vec<4, T> color, T t);
 
 }  // namespace refray::procedural::d3d12

@@ -83,6 +83,22 @@ uint32_t loadDword(const uint8_t* data, size_t sizeInBytes, uint32_t offset) {
     return value;
 }
 
+// The index triplet inside the 8 bytes Load2 read at the dword-aligned offset.
+uvec3 unpack3x16BitIndices(uint32_t offsetBytes, uvec2 four16BitIndices) {
+    const uint32_t dwordAlignedOffset = offsetBytes & ~3u;
+    uvec3 result;
+    if (dwordAlignedOffset == offsetBytes) {  // aligned: { 0 1 | 2 - }
+        result.x = four16BitIndices.x & 0xffff;
+        result.y = (four16BitIndices.x >> 16) & 0xffff;
+        result.z = four16BitIndices.y & 0xffff;
+    } else {  // not aligned: { - 0 | 1 2 }
+        result.x = (four16BitIndices.x >> 16) & 0xffff;
+        result.y = four16BitIndices.y & 0xffff;
+        result.z = (four16BitIndices.y >> 16) & 0xffff;
+    }
+    return result;
+}
+
 }  // namespace
 
 template <typename T>
@@ -95,19 +111,8 @@ tvec4<T> mul(const tvec4<T>& v, const Float4x4& M) {
 
 uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t sizeInBytes) {
     const uint32_t dwordAlignedOffset = offsetBytes & ~3u;
-    const uvec2 four16BitIndices(loadDword(indices, sizeInBytes, dwordAlignedOffset),
-                                 loadDword(indices, sizeInBytes, dwordAlignedOffset + 4));
-    uvec3 result;
-    if (dwordAlignedOffset == offsetBytes) {  // aligned: { 0 1 | 2 - }
-        result.x = four16BitIndices.x & 0xffff;
-        result.y = (four16BitIndices.x >> 16) & 0xffff;
-        result.z = four16BitIndices.y & 0xffff;
-    } else {  // not aligned: { - 0 | 1 2 }
-        result.x = (four16BitIndices.x >> 16) & 0xffff;
-        result.y = four16BitIndices.y & 0xffff;
-        result.z = (four16BitIndices.y >> 16) & 0xffff;
-    }
-    return result;
+    return unpack3x16BitIndices(offsetBytes, uvec2(loadDword(indices, sizeInBytes, dwordAlignedOffset),
+                                                   loadDword(indices, sizeInBytes, dwordAlignedOffset + 4)));
 }
 
 template <typename T>
@@ -394,10 +399,13 @@ void ClosestHit_Triangle(ShaderContext& ctx, RayPayload& rayPayload, const Built
     const uint32_t indicesPerTriangle = 3;
     const uint32_t triangleIndexStride = indicesPerTriangle * indexSizeInBytes;
     const uint32_t baseIndex = ctx.PrimitiveIndex() * triangleIndexStride;
-    // PORT: g_indices / g_vertices are the built-in copies (see kSlabIndices); out-of-range reads give 0.
-    const uvec3 indices = Load3x16BitIndices(baseIndex, reinterpret_cast<const uint8_t*>(kSlabIndices.data()),
-                                             sizeof(kSlabIndices));
-    const vec3 storedNormal = indices[0] < kSlabVertices.size() ? kSlabVertices[indices[0]].normal : vec3(0.0f);
+    // g_indices is t1 (descriptor 0 of the table at global parameter 4), g_vertices t2 (descriptor 1); reads past
+    // the end of a view give 0, as in D3D.
+    const GpuDescriptorHandle vertexBuffers = ctx.globalDescriptorTable(kVertexBuffers);
+    const uvec3 indices = unpack3x16BitIndices(
+        baseIndex, ctx.loadFromTable<uvec2>(vertexBuffers, /*g_indices*/ 0, /*Load2 at*/ baseIndex & ~3u));
+    const vec3 storedNormal =
+        ctx.loadFromTable<Vertex>(vertexBuffers, /*g_vertices*/ 1, uint64_t(indices[0]) * sizeof(Vertex)).normal;
     const tvec3<T> triangleNormal = -tvec3<T>(storedNormal);
 
     const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, g_sceneCB, rayPayload.recursionDepth);

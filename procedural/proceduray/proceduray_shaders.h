@@ -157,10 +157,9 @@ std::vector<dxr::HitGroupDesc> procedurayHitGroups();
 std::shared_ptr<dxr::ShaderLibrary> makeProcedurayShaderLibrary(Precision precision = Precision::Float);
 
 // ---- The slab's index and vertex buffers (§1.1) ----------------------------------------------------
-// What the scene uploads as g_indices (36 16-bit indices = 18 dwords) and g_vertices (8 vertices).
-// PORT: ClosestHit_Triangle reads these copies instead of the buffers bound through global parameter 4. It was
-// written before ShaderContext::loadFromTable could read buffer views through a table; TODO(issue 3): read the
-// bound g_indices / g_vertices once the Proceduray scene binds them.
+// What the scene uploads as g_indices (36 16-bit indices = 18 dwords, a raw view) and g_vertices (8 vertices,
+// stride 24), which ClosestHit_Triangle reads through the descriptor table of global parameter 4. Scene data for
+// hosts and tests; the shaders never read these arrays.
 extern const std::array<uint16_t, 36> kSlabIndices;
 extern const std::array<Vertex, 8> kSlabVertices;
 

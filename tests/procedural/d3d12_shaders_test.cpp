@@ -432,7 +432,7 @@ public:
     DispatchResult dispatch(const std::string& rayGen, bool useProbes, uint32_t width = 1, uint32_t height = 1) {
         StateObjectDesc desc;
         desc.name = "d3d12 test";
-        desc.libraries = {{makeD3D12ShaderLibrary(), {}}, {probes_, {}}};
+        desc.libraries = {{makeD3D12ShaderLibrary(precision), {}}, {probes_, {}}};
         desc.hitGroups = d3d12HitGroups();
         std::vector<std::string> triangleGroups = triangleHitGroupNames();
         std::vector<std::string> aabbGroups = aabbHitGroupNames();
@@ -502,14 +502,26 @@ public:
     }
 
     Device device;
+    Precision precision = Precision::Float;  // of the library under test
     SceneConstantBuffer scene{};
     RayDesc probeRay;
     Probe probe;
+    uint32_t shadowPayloadWord = 0;  // what RG_ShadowProbe's payload held after its TraceRay
     Image output;
     std::array<Vertex, 4> boundVertices = kPlaneVertices;  // what g_vertices holds (the BLAS uses kPlaneVertices)
 
 private:
     void addProbeShaders() {
+        // A shadow ray as TraceShadowRayAndReportIfHit traces it, but with every bit of the payload set.
+        probes_->addRayGeneration("RG_ShadowProbe", [this](ShaderContext& ctx) {
+            ShadowRayPayload payload{0xffffffffu};
+            ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure),
+                         RAY_FLAG_CULL_BACK_FACING_TRIANGLES | RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH |
+                             RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_SKIP_CLOSEST_HIT_SHADER,
+                         TraceRayParameters::InstanceMask, RayType::Shadow, TraceRayParameters::GeometryStride,
+                         RayType::Shadow, probeRay, payload);
+            shadowPayloadWord = payload.hit;
+        });
         probes_->addRayGeneration("RG_Probe", [this](ShaderContext& ctx) {
             RayPayload payload{vec4(0.0f), 1};
             ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_CULL_BACK_FACING_TRIANGLES,
@@ -857,6 +869,105 @@ TEST(D3D12Shaders, WholeSceneRenderMissColourAndFiniteness) {
             if (c != BackgroundColor) ++ground;
         }
     EXPECT_GT(ground, 32 * 18 / 2);  // the horizon is near the top (rows 88-89 of 720)
+}
+
+// ---- PORT tests ----------------------------------------------------------------------------------------
+
+// PORT (MyRaygenShader): the render target keeps the float colour; the R8G8B8A8_UNORM conversion happens only when
+// the image is written out (H20). The red box's shaded components are not multiples of 1/255.
+TEST(D3D12Shaders, PORT_RaygenStoresUnquantisedFloats) {
+    D3D12Rig rig(false, {0});
+    rig.setPointCamera(vec3(0.0f, 1.5f, -6.0f), vec3(1, 0, 0), vec3(0.0f), vec3(0.0f));
+    rig.dispatch("MyRaygenShader", false);
+    const vec4 got = rig.output.at(0, 0);
+    for (int c = 0; c < 3; ++c) {
+        const float quantised = std::round(std::clamp(got[c], 0.0f, 1.0f) * 255.0f) / 255.0f;
+        EXPECT_GT(std::fabs(got[c] - quantised), 1e-5f) << "component " << c;
+    }
+}
+
+// PORT (ShadowRayPayload): the payload mirrors the HLSL's 32-bit bool, not the C++ header's 1-byte bool (I11):
+// MyMissShader_ShadowRay clears the whole word, and a shadow hit (closest hit skipped) leaves it untouched.
+TEST(D3D12Shaders, PORT_ShadowRayPayloadIsAWholeWord) {
+    static_assert(sizeof(ShadowRayPayload) == 4);
+    D3D12Rig rig(false, {0});
+    rig.probeRay = {vec3(0.0f, 1.5f, -6.0f), 0.0f, vec3(0, 1, 0), 10000.0f};  // misses the red box
+    rig.dispatch("RG_ShadowProbe", false);
+    EXPECT_EQ(rig.shadowPayloadWord, 0u);
+    rig.probeRay = {vec3(0.0f, 1.5f, -6.0f), 0.0f, vec3(1, 0, 0), 10000.0f};  // enters its -x face
+    rig.dispatch("RG_ShadowProbe", false);
+    EXPECT_EQ(rig.shadowPayloadWord, 0xffffffffu);
+}
+
+// PORT (the helpers' intrinsics are parameters): a 3×2 dispatch over the bare ground; every pixel's colour is what
+// the exported helpers give when handed that pixel's DispatchRaysIndex(), DispatchRaysDimensions() and
+// WorldRayDirection(): grid filter from the neighbours' primary rays (I7), Phong, Fresnel reflection of the
+// background (the reflection and the shadow ray both miss), then the fog.
+TEST(D3D12Shaders, PORT_HelpersWithIntrinsicsAsParametersReproduceTheShader) {
+    D3D12Rig rig(true, {});
+    rig.setPointCamera(vec3(3.01f, 10.0f, 7.5f), vec3(0, -1, 0), vec3(0.5f, 0, 0), vec3(0, 0, 0.5f));
+    const uvec2 dims(3, 2);
+    rig.dispatch("MyRaygenShader", false, dims.x, dims.y);
+    const vec3 N(0, 1, 0);
+    for (uint32_t y = 0; y < dims.y; ++y)
+        for (uint32_t x = 0; x < dims.x; ++x) {
+            vec3 origin, D;
+            GenerateCameraRay(uvec2(x, y), dims, vec3(rig.scene.cameraPosition), rig.scene.projectionToWorld, origin, D);
+            const float t = -origin.y / D.y;
+            const vec3 P = origin + t * D;
+            const float checkers = AnalyticalCheckersTexture(P, N, vec3(rig.scene.cameraPosition),
+                                                             rig.scene.projectionToWorld, uvec2(x, y), dims);
+            const vec4 phong = CalculatePhongLighting(rig.scene, kPlaneMaterial.albedo, N, false, kPlaneMaterial.diffuseCoef,
+                                                      kPlaneMaterial.specularCoef, kPlaneMaterial.specularPower, P, D);
+            const vec4 reflected = kPlaneMaterial.reflectanceCoef *
+                                   vec4(FresnelReflectanceSchlick(D, N, vec3(kPlaneMaterial.albedo)), 1.0f) * BackgroundColor;
+            const vec4 expected = ApplyVisibilityFalloff(checkers * (phong + reflected), t);
+            const vec4 got = rig.output.at(x, y);
+            for (int c = 0; c < 4; ++c) EXPECT_NEAR(got[c], expected[c], 1e-5f) << x << "," << y << " component " << c;
+        }
+    // The pixels really differ in their grid footprint (the index and dimensions matter).
+    EXPECT_NE(rig.output.at(0, 0), rig.output.at(2, 1));
+}
+
+// PORT (makeD3D12ShaderLibrary's precision): the double library has the same exports and interface types, and
+// renders the same shading; d3d12_contract_test.cpp runs every intersection shader in both and bounds the
+// differences. The double run is also free of the float run's rounding: the red box colour agrees to 1e-6 (float
+// rounding of a colour ~0.5 through ~30 operations is ~1e-7 relative).
+TEST(D3D12Shaders, PORT_DoublePrecisionLibraryHasTheSameInterfaceAndShading) {
+    const auto f = makeD3D12ShaderLibrary(Precision::Float);
+    const auto d = makeD3D12ShaderLibrary(Precision::Double);
+    ASSERT_EQ(f->exports().size(), d->exports().size());
+    for (const auto& [name, e] : f->exports()) {
+        const ShaderExport* other = d->find(name);
+        ASSERT_NE(other, nullptr) << name;
+        EXPECT_EQ(other->stage, e.stage) << name;
+        EXPECT_EQ(other->payload, e.payload) << name;
+        EXPECT_EQ(other->attributes, e.attributes) << name;
+    }
+    vec4 colour[2];
+    for (int k = 0; k < 2; ++k) {
+        D3D12Rig rig(false, {0});
+        rig.precision = k == 0 ? Precision::Float : Precision::Double;
+        rig.setPointCamera(vec3(0.0f, 1.5f, -6.0f), vec3(1, 0, 0), vec3(0.0f), vec3(0.0f));
+        rig.dispatch("MyRaygenShader", false);
+        colour[k] = rig.output.at(0, 0);
+    }
+    for (int c = 0; c < 4; ++c) EXPECT_NEAR(colour[0][c], colour[1][c], 1e-6f) << "component " << c;
+    // The ground's grid and fog in double, against the double-precision expectation of GroundPlaneGridShadingAndFog.
+    D3D12Rig ground(true, {});
+    ground.precision = Precision::Double;
+    ground.setPointCamera(vec3(3.01f, 10.0f, 7.5f), vec3(0, -1, 0), vec3(0.002f, 0, 0), vec3(0, 0, 0.002f));
+    ground.dispatch("MyRaygenShader", false);
+    const dvec4 expected = expectedGroundColor(dvec3(3.01, 0, 7.5), 10.0, false, 0.5);
+    for (int c = 0; c < 4; ++c) EXPECT_NEAR(ground.output.at(0, 0)[c], expected[c], 1e-4) << "component " << c;
+}
+
+// The double helpers instantiate and agree with the float ones on the fact-sheet values.
+TEST(D3D12Shaders, HelpersInDoubleMatchTheFloatOnes) {
+    EXPECT_NEAR(CheckersTextureBoxFilter(glm::dvec2(3.005, 7.5), glm::dvec2(0.02, 0.0), glm::dvec2(0.0, 0.02), 50), 0.25,
+                1e-6);
+    EXPECT_NEAR(ApplyVisibilityFalloff(dvec4(0.0), 70.24).z, 0.5, 1e-3);
+    EXPECT_NEAR(FresnelReflectanceSchlick(dvec3(0, -1, 0), dvec3(0, 1, 0), dvec3(0.9)).x, 0.9, 1e-12);
 }
 
 }  // namespace

@@ -216,11 +216,12 @@ public:
         build(g, transform, 0);
     }
 
-    // Binds `vertices` as g_vertices (descriptor 2 of the table at global parameter 4).
-    void bindVertices(const std::array<Vertex, 8>& vertices) {
+    // Binds `vertices` as g_vertices (descriptor 2 of the heap, 1 of the table at global parameter 4); the view
+    // covers the first `viewVertices` of them.
+    void bindVertices(const std::array<Vertex, 8>& vertices, uint32_t viewVertices = 8) {
         heap_->setBuffer(2, DescriptorRangeType::SRV,
-                         {device.memory().upload(vertices.data(), sizeof(vertices), "g_vertices"), sizeof(vertices),
-                          sizeof(Vertex)});
+                         {device.memory().upload(vertices.data(), sizeof(vertices), "g_vertices"),
+                          viewVertices * sizeof(Vertex), sizeof(Vertex)});
     }
 
     // The ray the probe ray generation traces with the radiance arguments of §1.4.
@@ -445,27 +446,76 @@ TEST(ProcedurayShaders, RaygenShadesThePacmanHeadWithPhongAndReflection) {
     for (int c = 0; c < 4; ++c) EXPECT_NEAR(got[c], expected[c], 1e-3) << "component " << c;
 }
 
-// ClosestHit_Triangle on the slab's top face (triangles 6-7, N = -stored normal = +y) seen from above:
-// lit (the shadow ray leaves the face, which is back-facing to it), reflection = background.
-TEST(ProcedurayShaders, RaygenShadesTheSlabTopWithPhongAndReflection) {
-    constexpr PrimitiveConstantBuffer kPlaneMaterial{{1.0f, 0.9f, 0.7f, 1.0f}, 0.25f, 1.0f, 0.4f, 50.0f, 1.0f, vec3(0.0f)};
-    ProcedurayRig rig(Matrix3x4::scale(vec3(120, 15, 120)), kPlaneMaterial);
-    rig.scene.cameraPosition = vec4(0, 10, 0, 1);
-    rig.scene.projectionToWorld.m[3] = {0.0f, 9.0f, 0.0f, 1.0f};  // looks along -y
-    const DispatchResult result = rig.dispatch("Raygen", "HitGroup_Triangle", "Miss");
-    EXPECT_EQ(result.stats.raysTraced, 3u);
-    EXPECT_EQ(result.stats.invocationsOf(ShaderStage::Miss), 2u);
-
-    const dvec3 D(0, -1, 0), N(0, 1, 0), P(0, 3, 0);
+// The colour of ClosestHit_Triangle on the slab's top face P = (0, 3, 0), seen straight down (D = -y), lit, with the
+// background as the reflection, for the normal N it read from g_vertices (§3.1/§3.3, in double).
+glm::dvec4 expectedSlabTopColor(const dvec3& N) {
+    const dvec3 D(0, -1, 0), P(0, 3, 0);
     const dvec3 L = glm::normalize(P - dvec3(0, 18, -20));
     const double Kd = std::clamp(glm::dot(-L, N), 0.0, 1.0);
     const dvec3 R = glm::normalize(L - 2.0 * glm::dot(N, L) * N);
     const double Ks = std::pow(std::clamp(glm::dot(R, -D), 0.0, 1.0), 50.0);
-    const glm::dvec4 albedo(1.0, 0.9, 0.7, 1.0), A(0.25, 0.25, 0.25, 1);
-    const glm::dvec4 expected = albedo * A + Kd * glm::dvec4(0.6, 0.6, 0.6, 1) * albedo + glm::dvec4(0.4 * Ks) +
-                                0.25 * albedo * glm::dvec4(0.6, 0.7, 0.9, 1.0);
-    const vec4 got = rig.output.at(0, 0);
+    const glm::dvec4 albedo(1.0, 0.9, 0.7, 1.0), A(0.25, 0.25, 0.25, 1), background(0.6, 0.7, 0.9, 1.0);
+    const double a = 1.0 - std::clamp(-N.y, 0.0, 1.0);
+    const dvec3 f0(albedo);
+    const dvec3 F = f0 + (1.0 - f0) * std::pow(1.0 - std::clamp(glm::dot(-D, N), 0.0, 1.0), 5.0);
+    return albedo * ((A - 0.1) + a * 0.1) + Kd * glm::dvec4(0.6, 0.6, 0.6, 1) * albedo + glm::dvec4(0.4 * Ks) +
+           0.25 * glm::dvec4(F, 1.0) * background;
+}
+
+constexpr PrimitiveConstantBuffer kSlabMaterial{{1.0f, 0.9f, 0.7f, 1.0f}, 0.25f, 1.0f, 0.4f, 50.0f, 1.0f, vec3(0.0f)};
+
+// Renders the slab's top face from above through Raygen -> ClosestHit_Triangle; `bind` may rebind g_vertices.
+// With a normal that points along the face (`lit` false) the rays are not checked: a zero normal sends the
+// reflection ray down into the slab.
+template <class Bind>
+vec4 renderSlabTop(Bind&& bind, bool lit = true) {
+    ProcedurayRig rig(Matrix3x4::scale(vec3(120, 15, 120)), kSlabMaterial);
+    bind(rig);
+    rig.scene.cameraPosition = vec4(0, 10, 0, 1);
+    rig.scene.projectionToWorld.m[3] = {0.0f, 9.0f, 0.0f, 1.0f};  // looks along -y
+    const DispatchResult result = rig.dispatch("Raygen", "HitGroup_Triangle", "Miss");
+    if (lit) {
+        EXPECT_EQ(result.stats.raysTraced, 3u);  // primary, shadow, reflection
+        EXPECT_EQ(result.stats.invocationsOf(ShaderStage::Miss), 2u);
+    }
+    return rig.output.at(0, 0);
+}
+
+// ClosestHit_Triangle on the slab's top face (triangles 6-7, N = -stored normal = +y) seen from above:
+// lit (the shadow ray leaves the face, which is back-facing to it), reflection = background.
+TEST(ProcedurayShaders, RaygenShadesTheSlabTopWithPhongAndReflection) {
+    const vec4 got = renderSlabTop([](ProcedurayRig&) {});
+    const glm::dvec4 expected = expectedSlabTopColor(dvec3(0, 1, 0));
     for (int c = 0; c < 4; ++c) EXPECT_NEAR(got[c], expected[c], 1e-4) << "component " << c;
+}
+
+// ClosestHit_Triangle reads g_indices / g_vertices through the descriptor table of global parameter 4 (the rig
+// binds both views, as the scene does): the top face's first index is 3, and giving g_vertices[3] the stored
+// normal +y (so N = -y) shades the same hit as a face turned down: 0.15 ambient, no diffuse, Fresnel factor 1.
+TEST(ProcedurayShaders, ClosestHitTriangleReadsTheBoundVertexBuffer) {
+    const vec4 got = renderSlabTop([](ProcedurayRig& rig) {
+        std::array<Vertex, 8> vertices = kSlabVertices;
+        vertices[3].normal = vec3(0, 1, 0);
+        rig.bindVertices(vertices);
+    });
+    const glm::dvec4 expected = expectedSlabTopColor(dvec3(0, -1, 0));
+    for (int c = 0; c < 4; ++c) EXPECT_NEAR(got[c], expected[c], 1e-4) << "component " << c;
+    EXPECT_GT(std::fabs(double(got.x) - expectedSlabTopColor(dvec3(0, 1, 0)).x), 0.1);
+}
+
+// A g_vertices view that ends before vertex 3 reads zeros there (D3D out-of-range loads): the same colour as a
+// bound vertex 3 whose normal is zero.
+TEST(ProcedurayShaders, ClosestHitTriangleReadsZerosPastTheEndOfTheView) {
+    const vec4 truncated = renderSlabTop([](ProcedurayRig& rig) { rig.bindVertices(kSlabVertices, 3); }, false);
+    const vec4 zeroNormal = renderSlabTop(
+        [](ProcedurayRig& rig) {
+            std::array<Vertex, 8> vertices = kSlabVertices;
+            vertices[3].normal = vec3(0.0f);
+            rig.bindVertices(vertices);
+        },
+        false);
+    EXPECT_EQ(truncated, zeroNormal);
+    EXPECT_NE(truncated, renderSlabTop([](ProcedurayRig&) {}));
 }
 
 // PORT (Raygen): the render target keeps the float colour; quantisation to R8G8B8A8_UNORM happens only when
@@ -480,27 +530,6 @@ TEST(ProcedurayShaders, PORT_RaygenStoresUnquantisedFloats) {
         const float quantised = std::round(std::clamp(got[c], 0.0f, 1.0f) * 255.0f) / 255.0f;
         EXPECT_GT(std::fabs(got[c] - quantised), 1e-5f) << "component " << c;
     }
-}
-
-// PORT (kSlabIndices / ClosestHit_Triangle): the slab's normals come from the built-in copies, not from the
-// g_vertices bound at global parameter 4: binding vertices with zero normals leaves the shading unchanged.
-TEST(ProcedurayShaders, PORT_ClosestHitTriangleReadsTheBuiltInSlabCopies) {
-    constexpr PrimitiveConstantBuffer kPlaneMaterial{{1.0f, 0.9f, 0.7f, 1.0f}, 0.25f, 1.0f, 0.4f, 50.0f, 1.0f, vec3(0.0f)};
-    auto render = [&](bool zeroNormals) {
-        ProcedurayRig rig(Matrix3x4::scale(vec3(120, 15, 120)), kPlaneMaterial);
-        if (zeroNormals) {
-            std::array<Vertex, 8> vertices = kSlabVertices;
-            for (Vertex& v : vertices) v.normal = vec3(0.0f);
-            rig.bindVertices(vertices);
-        }
-        rig.scene.cameraPosition = vec4(0, 10, 0, 1);
-        rig.scene.projectionToWorld.m[3] = {0.0f, 9.0f, 0.0f, 1.0f};
-        rig.dispatch("Raygen", "HitGroup_Triangle", "Miss");
-        return rig.output.at(0, 0);
-    };
-    const vec4 builtIn = render(false);
-    EXPECT_GT(builtIn.x, 0.5f);  // lit from +y: the normal is not zero
-    EXPECT_EQ(render(true), builtIn);
 }
 
 // Pac-man A's mouth axis: o = (35,-35,50), d = -z, i.e. local o = (0,0,1), d = (0,0,-1).
