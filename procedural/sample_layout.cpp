@@ -1,5 +1,7 @@
 #include "procedural/sample_layout.h"
 
+#include <cstring>
+
 namespace refray::procedural {
 
 using namespace refray::dxr;
@@ -30,6 +32,36 @@ RootSignatureDesc sampleProceduralLocalRootSignatureDesc(std::string name, uint3
     RootSignatureDesc desc = sampleTriangleLocalRootSignatureDesc(std::move(name), materialBytes);
     desc.parameters.push_back(RootParameter::constants(instanceBytes / 4, 2));
     return desc;
+}
+
+namespace {
+// A ByteAddressBuffer dword; past the end it reads 0, as an out-of-bounds buffer load does in D3D12.
+uint32_t loadDword(const uint8_t* data, size_t sizeInBytes, uint32_t offset) {
+    uint32_t value = 0;
+    if (uint64_t(offset) + 4 <= sizeInBytes) std::memcpy(&value, data + offset, 4);
+    return value;
+}
+}  // namespace
+
+uvec3 unpack3x16BitIndices(uint32_t offsetBytes, uvec2 four16BitIndices) {
+    const uint32_t dwordAlignedOffset = offsetBytes & ~3u;
+    uvec3 result;
+    if (dwordAlignedOffset == offsetBytes) {  // aligned: { 0 1 | 2 - }
+        result.x = four16BitIndices.x & 0xffff;
+        result.y = (four16BitIndices.x >> 16) & 0xffff;
+        result.z = four16BitIndices.y & 0xffff;
+    } else {  // not aligned: { - 0 | 1 2 }
+        result.x = (four16BitIndices.x >> 16) & 0xffff;
+        result.y = four16BitIndices.y & 0xffff;
+        result.z = (four16BitIndices.y >> 16) & 0xffff;
+    }
+    return result;
+}
+
+uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t sizeInBytes) {
+    const uint32_t dwordAlignedOffset = offsetBytes & ~3u;
+    return unpack3x16BitIndices(offsetBytes, uvec2(loadDword(indices, sizeInBytes, dwordAlignedOffset),
+                                                   loadDword(indices, sizeInBytes, dwordAlignedOffset + 4)));
 }
 
 }  // namespace refray::procedural

@@ -6,7 +6,9 @@
 #include <cstdint>
 #include <string>
 
+#include "core/math.h"
 #include "emulator/root_signature.h"
+#include "procedural/math/hlsl.h"
 
 namespace refray::procedural {
 
@@ -25,5 +27,50 @@ dxr::RootSignatureDesc sampleTriangleLocalRootSignatureDesc(std::string name, ui
 // Local, procedural: the material at b1, then the per-instance constants at b2.
 dxr::RootSignatureDesc sampleProceduralLocalRootSignatureDesc(std::string name, uint32_t materialBytes,
                                                               uint32_t instanceBytes);
+
+// mul(v, M) for a row vector, summed in row order (HLSL mul with /Zpr matrices).
+template <typename T>
+glm::vec<4, T> mul(const glm::vec<4, T>& v, const Float4x4& M) {
+    glm::vec<4, T> r;
+    for (int j = 0; j < 4; ++j)
+        r[j] = v.x * T(M.m[0][j]) + v.y * T(M.m[1][j]) + v.z * T(M.m[2][j]) + v.w * T(M.m[3][j]);
+    return r;
+}
+
+// mul(v, (float3x3)M): the upper-left 3x3, row vector on the left.
+template <typename T>
+glm::vec<3, T> mul3x3(const glm::vec<3, T>& v, const Float4x4& M) {
+    glm::vec<3, T> r;
+    for (int j = 0; j < 3; ++j) r[j] = v.x * T(M.m[0][j]) + v.y * T(M.m[1][j]) + v.z * T(M.m[2][j]);
+    return r;
+}
+
+// FresnelReflectanceSchlick(I, N, f0) = f0 + (1 - f0)·pow(1 - saturate(dot(-I, N)), 5).
+template <typename T>
+glm::vec<3, T> FresnelReflectanceSchlick(glm::vec<3, T> I, glm::vec<3, T> N, glm::vec<3, T> f0) {
+    const T cosi = hlsl::saturate(hlsl::dot(-I, N));
+    return f0 + (T(1) - f0) * hlsl::pow(T(1) - cosi, T(5));
+}
+
+// GenerateCameraRay: pixel centre, y flipped, unprojected with mul(float4(s, 0, 1),
+// projectionToWorld) and divided by w; origin = cameraPosition, direction normalized.
+template <typename T>
+void GenerateCameraRay(uvec2 index, uvec2 dimensions, glm::vec<3, T> cameraPosition, const Float4x4& projectionToWorld,
+                       glm::vec<3, T>& origin, glm::vec<3, T>& direction) {
+    const glm::vec<2, T> xy = glm::vec<2, T>(index) + T(0.5f);
+    glm::vec<2, T> screenPos = xy / glm::vec<2, T>(dimensions) * T(2) - T(1);
+    screenPos.y = -screenPos.y;
+    const glm::vec<4, T> world = mul(glm::vec<4, T>(screenPos, T(0), T(1)), projectionToWorld);
+    const glm::vec<3, T> worldXYZ = glm::vec<3, T>(world) / world.w;
+    origin = cameraPosition;
+    direction = hlsl::normalize(worldXYZ - origin);
+}
+
+// The index triplet inside the 8 bytes a ByteAddressBuffer Load2 read at the dword-aligned
+// offset below `offsetBytes`.
+uvec3 unpack3x16BitIndices(uint32_t offsetBytes, uvec2 four16BitIndices);
+// Load3x16BitIndices: the three 16-bit indices at byte `offsetBytes`, read as two aligned
+// dwords the way a ByteAddressBuffer Load2 does. Dwords past `sizeInBytes` read 0.
+uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t sizeInBytes);
 
 }  // namespace refray::procedural

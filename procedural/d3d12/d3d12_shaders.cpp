@@ -81,70 +81,7 @@ using tvec3 = math::vec3<T>;
 template <typename T>
 using tvec4 = math::vec4<T>;
 
-// mul(v, (float3x3)M): the upper-left 3x3 of a row-major matrix, row vector on the left.
-template <typename T>
-tvec3<T> mul3x3(const tvec3<T>& v, const Float4x4& M) {
-    tvec3<T> r;
-    for (int j = 0; j < 3; ++j) r[j] = v.x * T(M.m[0][j]) + v.y * T(M.m[1][j]) + v.z * T(M.m[2][j]);
-    return r;
-}
-
-// A ByteAddressBuffer dword; past the end it reads 0, as an out-of-bounds buffer load does in D3D12.
-uint32_t loadDword(const uint8_t* data, size_t sizeInBytes, uint32_t offset) {
-    uint32_t value = 0;
-    if (uint64_t(offset) + 4 <= sizeInBytes) std::memcpy(&value, data + offset, 4);
-    return value;
-}
-
-// The index triplet inside the 8 bytes Load2 read at the dword-aligned offset.
-uvec3 unpack3x16BitIndices(uint32_t offsetBytes, uvec2 four16BitIndices) {
-    const uint32_t dwordAlignedOffset = offsetBytes & ~3u;
-    uvec3 result;
-    if (dwordAlignedOffset == offsetBytes) {  // aligned: { 0 1 | 2 - }
-        result.x = four16BitIndices.x & 0xffff;
-        result.y = (four16BitIndices.x >> 16) & 0xffff;
-        result.z = four16BitIndices.y & 0xffff;
-    } else {  // not aligned: { - 0 | 1 2 }
-        result.x = (four16BitIndices.x >> 16) & 0xffff;
-        result.y = four16BitIndices.y & 0xffff;
-        result.z = (four16BitIndices.y >> 16) & 0xffff;
-    }
-    return result;
-}
-
 }  // namespace
-
-uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t sizeInBytes) {
-    const uint32_t dwordAlignedOffset = offsetBytes & ~3u;
-    return unpack3x16BitIndices(offsetBytes, uvec2(loadDword(indices, sizeInBytes, dwordAlignedOffset),
-                                                   loadDword(indices, sizeInBytes, dwordAlignedOffset + 4)));
-}
-
-template <typename T>
-tvec4<T> mul(const tvec4<T>& v, const Float4x4& M) {
-    tvec4<T> r;
-    for (int j = 0; j < 4; ++j)
-        r[j] = v.x * T(M.m[0][j]) + v.y * T(M.m[1][j]) + v.z * T(M.m[2][j]) + v.w * T(M.m[3][j]);
-    return r;
-}
-
-template <typename T>
-void GenerateCameraRay(uvec2 index, uvec2 dimensions, tvec3<T> cameraPosition, const Float4x4& projectionToWorld,
-                       tvec3<T>& origin, tvec3<T>& direction) {
-    const tvec2<T> xy = tvec2<T>(index) + T(0.5f);
-    tvec2<T> screenPos = xy / tvec2<T>(dimensions) * T(2) - T(1);
-    screenPos.y = -screenPos.y;
-    const tvec4<T> world = mul(tvec4<T>(screenPos, T(0), T(1)), projectionToWorld);
-    const tvec3<T> worldXYZ = tvec3<T>(world) / world.w;
-    origin = cameraPosition;
-    direction = hlsl::normalize(worldXYZ - origin);
-}
-
-template <typename T>
-tvec3<T> FresnelReflectanceSchlick(tvec3<T> I, tvec3<T> N, tvec3<T> f0) {
-    const T cosi = hlsl::saturate(hlsl::dot(-I, N));
-    return f0 + (T(1) - f0) * hlsl::pow(T(1) - cosi, T(5));
-}
 
 template <typename T>
 T CheckersTextureBoxFilter(tvec2<T> uv, tvec2<T> dpdx, tvec2<T> dpdy, uint32_t ratio) {
@@ -231,9 +168,6 @@ tvec4<T> ApplyVisibilityFalloff(tvec4<T> color, T t) {
 }
 
 #define REFRAY_INSTANTIATE_HELPERS(T)                                                                               \
-    template tvec4<T> mul<T>(const tvec4<T>&, const Float4x4&);                                                     \
-    template void GenerateCameraRay<T>(uvec2, uvec2, tvec3<T>, const Float4x4&, tvec3<T>&, tvec3<T>&);             \
-    template tvec3<T> FresnelReflectanceSchlick<T>(tvec3<T>, tvec3<T>, tvec3<T>);                                  \
     template T CheckersTextureBoxFilter<T>(tvec2<T>, tvec2<T>, tvec2<T>, uint32_t);                                 \
     template void CalculateRayDifferentials<T>(tvec2<T>&, tvec2<T>&, tvec2<T>, tvec3<T>, tvec3<T>, tvec3<T>,        \
                                                const Float4x4&, uvec2, uvec2);                                      \

@@ -31,7 +31,12 @@ namespace refray::procedural::d3d12 {
 
 // ---- Shader-visible structs (RayTracingHlslCompat.h) -------------------------------------------------
 
-using procedural::Float4x4;  // procedural/sample_layout.h
+// Shared with the other reference scene's port (procedural/sample_layout.h).
+using procedural::Float4x4;
+using procedural::FresnelReflectanceSchlick;
+using procedural::GenerateCameraRay;
+using procedural::Load3x16BitIndices;
+using procedural::mul;
 
 struct RayPayload {
     vec4 color;
@@ -186,25 +191,7 @@ extern const std::array<Vertex, 4> kPlaneVertices;
 // ---- Pure helpers of the entry points, exposed for tests ---------------------------------------------
 // PORT: intrinsics these helpers read in HLSL (DispatchRaysIndex/Dimensions, WorldRayDirection) are parameters.
 
-// Load3x16BitIndices: the three 16-bit indices at byte `offsetBytes`, read as two aligned dwords the way a
-// ByteAddressBuffer Load2 does. Dwords past `sizeInBytes` read 0.
-uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t sizeInBytes);
-
 // The helpers below are templates on the scalar type, defined and instantiated (float, double) in the .cpp.
-
-// mul(v, M) for a row vector, summed in row order.
-template <typename T>
-glm::vec<4, T> mul(const glm::vec<4, T>& v, const Float4x4& M);
-
-// GenerateCameraRay: pixel centre, y flipped, unprojected with mul(float4(s, t, 0, 1), projectionToWorld), divided
-// by w; origin = cameraPosition, direction normalised (§2.1).
-template <typename T>
-void GenerateCameraRay(uvec2 index, uvec2 dimensions, glm::vec<3, T> cameraPosition, const Float4x4& projectionToWorld,
-                       glm::vec<3, T>& origin, glm::vec<3, T>& direction);
-
-// FresnelReflectanceSchlick(I, N, f0) = f0 + (1 - f0)·pow(1 - saturate(dot(-I, N)), 5).
-template <typename T>
-glm::vec<3, T> FresnelReflectanceSchlick(glm::vec<3, T> I, glm::vec<3, T> N, glm::vec<3, T> f0);
 
 // CheckersTextureBoxFilter: the grid of lines 1/ratio wide at every integer u and v, box-filtered over
 // w = max(|dpdx|, |dpdy|); 1 on the white cells, 0 on a line (§2.9 step 3).

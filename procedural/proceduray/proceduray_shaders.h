@@ -29,7 +29,12 @@ namespace refray::procedural::proceduray {
 
 // ---- Shader-visible structs (HLSL layout; the C++ side of the shared headers) ---------------------
 
-using procedural::Float4x4;  // procedural/sample_layout.h
+// Shared with the other reference scene's port (procedural/sample_layout.h).
+using procedural::Float4x4;
+using procedural::FresnelReflectanceSchlick;
+using procedural::GenerateCameraRay;
+using procedural::Load3x16BitIndices;
+using procedural::mul;
 
 // engine/Payloads.h. `hit` is an HLSL bool, i.e. a 32-bit value.
 struct RayPayload {
@@ -165,33 +170,15 @@ extern const std::array<Vertex, 8> kSlabVertices;
 
 // ---- Pure helpers of the entry points, exposed for tests -------------------------------------------
 
-// RaytracingShaderHelper.hlsli Load3x16BitIndices: the three 16-bit indices at byte `offsetBytes`,
-// read as two aligned dwords the way a ByteAddressBuffer Load2 does. Dwords past `sizeInBytes` read 0.
-uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t sizeInBytes);
-
 // The helpers below are templates on the scalar type, defined and instantiated (float, double) in the .cpp.
-
-// FresnelReflectanceSchlick(I, N, f0) = f0 + (1 - f0)·pow(1 - saturate(dot(-I, N)), 5).
-template <typename T>
-glm::vec<3, T> FresnelReflectanceSchlick(glm::vec<3, T> I, glm::vec<3, T> N, glm::vec<3, T> f0);
 
 // JuliaSets.hlsli colorSurface(pos, tn): the iteration-count palette (tn.y = n).
 template <typename T>
 glm::vec<3, T> colorSurface(glm::vec<3, T> pos, glm::vec<2, T> tn);
 
-// GenerateCameraRay: pixel centre, y flipped, unprojected with mul(float4(s, 0, 1), projectionToWorld).
-// Writes the ray's origin (cameraPosition) and normalised direction.
-template <typename T>
-void GenerateCameraRay(uvec2 index, uvec2 dimensions, glm::vec<3, T> cameraPosition, const Float4x4& projectionToWorld,
-                       glm::vec<3, T>& origin, glm::vec<3, T>& direction);
-
 // ClosestHit_Mandelbulb's own lighting (no scene light): the colour before the reflection is added.
 // D = WorldRayDirection(), N = attr.normal, trap = attr.color.
 template <typename T>
 glm::vec<4, T> MandelbulbSurfaceColor(glm::vec<3, T> D, glm::vec<3, T> N, glm::vec<4, T> trap);
-
-// mul(v, M) for a row vector, summed in row order.
-template <typename T>
-glm::vec<4, T> mul(const glm::vec<4, T>& v, const Float4x4& M);
 
 }  // namespace refray::procedural::proceduray
