@@ -5,6 +5,8 @@
 #include <optional>
 #include <string_view>
 
+#include "procedural/math/hlsl.h"
+
 namespace refray::procedural {
 
 enum class Precision { Float, Double };
@@ -19,5 +21,14 @@ constexpr std::optional<Precision> parsePrecision(std::string_view text) {
     if (text == "double") return Precision::Double;
     return std::nullopt;
 }
+
+// Held for the duration of a shader entry point: float mode runs with denormals flushed, as D3D
+// float32 arithmetic does (H18); the double oracle keeps them.
+template <typename T>
+struct PrecisionScope {};
+template <>
+struct PrecisionScope<float> {
+    hlsl::ScopedFlushDenormals ftz;
+};
 
 }  // namespace refray::procedural

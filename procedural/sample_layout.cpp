@@ -19,18 +19,17 @@ RootSignatureDesc sampleGlobalRootSignatureDesc(std::string name) {
     return desc;
 }
 
-RootSignatureDesc sampleTriangleLocalRootSignatureDesc(std::string name, uint32_t materialBytes) {
+RootSignatureDesc sampleTriangleLocalRootSignatureDesc(std::string name) {
     RootSignatureDesc desc;
     desc.name = std::move(name);
     desc.flags = ROOT_SIGNATURE_FLAG_LOCAL_ROOT_SIGNATURE;
-    desc.parameters = {RootParameter::constants(materialBytes / 4, 1)};
+    desc.parameters = {RootParameter::constants(sizeof(PrimitiveConstantBuffer) / 4, 1)};
     return desc;
 }
 
-RootSignatureDesc sampleProceduralLocalRootSignatureDesc(std::string name, uint32_t materialBytes,
-                                                         uint32_t instanceBytes) {
-    RootSignatureDesc desc = sampleTriangleLocalRootSignatureDesc(std::move(name), materialBytes);
-    desc.parameters.push_back(RootParameter::constants(instanceBytes / 4, 2));
+RootSignatureDesc sampleProceduralLocalRootSignatureDesc(std::string name) {
+    RootSignatureDesc desc = sampleTriangleLocalRootSignatureDesc(std::move(name));
+    desc.parameters.push_back(RootParameter::constants(sizeof(PrimitiveInstanceConstantBuffer) / 4, 2));
     return desc;
 }
 

@@ -19,14 +19,39 @@ struct Float4x4 {
 };
 static_assert(sizeof(Float4x4) == 64);
 
+// The material, as root constants at b1 of every hit group's local root signature.
+struct PrimitiveConstantBuffer {
+    vec4 albedo;
+    float reflectanceCoef;
+    float diffuseCoef;
+    float specularCoef;
+    float specularPower;
+    float stepScale;  // sphere-tracing step scale (which shaders read it: see each port)
+    vec3 padding;
+};
+static_assert(sizeof(PrimitiveConstantBuffer) == 48);
+
+// Per procedural record: 2 root constants at b2 (what the fields index differs per port).
+struct PrimitiveInstanceConstantBuffer {
+    uint32_t instanceIndex;
+    uint32_t primitiveType;
+};
+static_assert(sizeof(PrimitiveInstanceConstantBuffer) == 8);
+
+// An element of g_vertices (StructuredBuffer<Vertex>, stride 24).
+struct Vertex {
+    vec3 position;
+    vec3 normal;
+};
+static_assert(sizeof(Vertex) == 24);
+
 // Global: [0] table {UAV u0} render target, [1] root SRV t0 TLAS, [2] root CBV b0 scene
 // constants, [3] root SRV t3 instance buffer, [4] table {SRV t1, t2} indices and vertices.
 dxr::RootSignatureDesc sampleGlobalRootSignatureDesc(std::string name);
-// Local, triangles: the material as root constants at b1.
-dxr::RootSignatureDesc sampleTriangleLocalRootSignatureDesc(std::string name, uint32_t materialBytes);
-// Local, procedural: the material at b1, then the per-instance constants at b2.
-dxr::RootSignatureDesc sampleProceduralLocalRootSignatureDesc(std::string name, uint32_t materialBytes,
-                                                              uint32_t instanceBytes);
+// Local, triangles: PrimitiveConstantBuffer as root constants at b1.
+dxr::RootSignatureDesc sampleTriangleLocalRootSignatureDesc(std::string name);
+// Local, procedural: PrimitiveConstantBuffer at b1, then PrimitiveInstanceConstantBuffer at b2.
+dxr::RootSignatureDesc sampleProceduralLocalRootSignatureDesc(std::string name);
 
 // mul(v, M) for a row vector, summed in row order (HLSL mul with /Zpr matrices).
 template <typename T>

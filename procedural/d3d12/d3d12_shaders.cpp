@@ -32,12 +32,11 @@ const std::array<Vertex, 4> kPlaneVertices = {{
 RootSignatureDesc globalRootSignatureDesc() { return sampleGlobalRootSignatureDesc("GlobalRootSignature"); }
 
 RootSignatureDesc triangleLocalRootSignatureDesc() {
-    return sampleTriangleLocalRootSignatureDesc("Triangle", sizeof(PrimitiveConstantBuffer));
+    return sampleTriangleLocalRootSignatureDesc("Triangle");
 }
 
 RootSignatureDesc aabbLocalRootSignatureDesc() {
-    return sampleProceduralLocalRootSignatureDesc("AABB", sizeof(PrimitiveConstantBuffer),
-                                                  sizeof(PrimitiveInstanceConstantBuffer));
+    return sampleProceduralLocalRootSignatureDesc("AABB");
 }
 
 std::vector<HitGroupDesc> d3d12HitGroups() {
@@ -182,14 +181,6 @@ REFRAY_INSTANTIATE_HELPERS(double)
 // ---- Shader-side helpers (Raytracing.hlsl) ---------------------------------------------------------
 
 namespace {
-
-// Float mode runs with denormals flushed, as D3D float32 arithmetic does; the double oracle keeps them.
-template <typename T>
-struct PrecisionScope {};
-template <>
-struct PrecisionScope<float> {
-    hlsl::ScopedFlushDenormals ftz;
-};
 
 SceneConstantBuffer sceneCB(const ShaderContext& ctx) {
     return ctx.load<SceneConstantBuffer>(ctx.globalRootDescriptor(kSceneConstant));

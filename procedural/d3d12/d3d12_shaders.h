@@ -70,24 +70,11 @@ struct SceneConstantBuffer {
 static_assert(sizeof(SceneConstantBuffer) == 144);
 
 // The material: 12 root constants at b1 (§1.4).
-struct PrimitiveConstantBuffer {
-    vec4 albedo;
-    float reflectanceCoef;
-    float diffuseCoef;
-    float specularCoef;
-    float specularPower;
-    float stepScale;  // sphere-tracing step scale of the SDF primitives
-    vec3 padding;
-};
-static_assert(sizeof(PrimitiveConstantBuffer) == 48);
+using procedural::PrimitiveConstantBuffer;  // procedural/sample_layout.h
 
 // Per AABB primitive: 2 root constants at b2. instanceIndex is the primitive index i of §1.3 (it indexes
 // g_AABBPrimitiveAttributes); primitiveType is the enum of the hit group's intersection shader.
-struct PrimitiveInstanceConstantBuffer {
-    uint32_t instanceIndex;
-    uint32_t primitiveType;
-};
-static_assert(sizeof(PrimitiveInstanceConstantBuffer) == 8);
+using procedural::PrimitiveInstanceConstantBuffer;  // procedural/sample_layout.h
 
 // One element of StructuredBuffer<PrimitiveInstancePerFrameBuffer> (root SRV t3): S·R·Tr and its inverse.
 struct PrimitiveInstancePerFrameBuffer {
@@ -96,11 +83,7 @@ struct PrimitiveInstancePerFrameBuffer {
 };
 static_assert(sizeof(PrimitiveInstancePerFrameBuffer) == 128);
 
-struct Vertex {
-    vec3 position;
-    vec3 normal;
-};
-static_assert(sizeof(Vertex) == 24);
+using procedural::Vertex;  // procedural/sample_layout.h
 
 // LocalRootSignature::{Triangle, AABB}::RootArguments: the record bytes after the identifier.
 struct TriangleRootArguments {

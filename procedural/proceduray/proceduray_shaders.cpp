@@ -35,12 +35,11 @@ const std::array<Vertex, 8> kSlabVertices = {{
 RootSignatureDesc globalRootSignatureDesc() { return sampleGlobalRootSignatureDesc("GlobalSignature"); }
 
 RootSignatureDesc triangleLocalRootSignatureDesc() {
-    return sampleTriangleLocalRootSignatureDesc("Triangle", sizeof(PrimitiveConstantBuffer));
+    return sampleTriangleLocalRootSignatureDesc("Triangle");
 }
 
 RootSignatureDesc proceduralLocalRootSignatureDesc() {
-    return sampleProceduralLocalRootSignatureDesc("Procedural", sizeof(PrimitiveConstantBuffer),
-                                                  sizeof(PrimitiveInstanceConstantBuffer));
+    return sampleProceduralLocalRootSignatureDesc("Procedural");
 }
 
 std::vector<HitGroupDesc> procedurayHitGroups() {
@@ -129,14 +128,6 @@ REFRAY_INSTANTIATE_HELPERS(double)
 // ---- Shader-side helpers (Helpers.hlsli, RaytracingShaderHelper.hlsli) -----------------------------
 
 namespace {
-
-// Float mode runs with denormals flushed (H18); the double oracle keeps them.
-template <typename T>
-struct PrecisionScope {};
-template <>
-struct PrecisionScope<float> {
-    hlsl::ScopedFlushDenormals ftz;
-};
 
 SceneConstantBuffer sceneCB(const ShaderContext& ctx) {
     return ctx.load<SceneConstantBuffer>(ctx.globalRootDescriptor(kSceneConstantBuffer));

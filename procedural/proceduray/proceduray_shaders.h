@@ -60,24 +60,11 @@ struct ProceduralPrimitiveAttributes {
 static_assert(sizeof(ProceduralPrimitiveAttributes) == 28);
 
 // engine/RootComponents.h: the material (12 root constants at b1).
-struct PrimitiveConstantBuffer {
-    vec4 albedo;
-    float reflectanceCoef;
-    float diffuseCoef;
-    float specularCoef;
-    float specularPower;
-    float stepScale;  // read by the Pac-man march only
-    vec3 padding;
-};
-static_assert(sizeof(PrimitiveConstantBuffer) == 48);
+using procedural::PrimitiveConstantBuffer;  // procedural/sample_layout.h
 
 // Per procedural instance (2 root constants at b2). instanceIndex is the procedural ordinal (0..3), not
 // InstanceIndex(); primitiveType is a SignedDistancePrimitive.
-struct PrimitiveInstanceConstantBuffer {
-    uint32_t instanceIndex;
-    uint32_t primitiveType;
-};
-static_assert(sizeof(PrimitiveInstanceConstantBuffer) == 8);
+using procedural::PrimitiveInstanceConstantBuffer;  // procedural/sample_layout.h
 
 // engine/RootArguments.h: the record bytes after the identifier.
 struct TriangleRootArguments {
@@ -113,11 +100,7 @@ struct InstanceBuffer {
 static_assert(sizeof(InstanceBuffer) == 128);
 
 // engine/ShaderCompat.h: the slab's vertex (StructuredBuffer<Vertex>, 24-byte stride).
-struct Vertex {
-    vec3 position;
-    vec3 normal;
-};
-static_assert(sizeof(Vertex) == 24);
+using procedural::Vertex;  // procedural/sample_layout.h
 
 // ---- Constants of engine/ShaderCompat.h ------------------------------------------------------------
 
