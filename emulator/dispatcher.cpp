@@ -298,28 +298,15 @@ AnyHitOutcome runAnyHit(ThreadState& ts, RayState& rs, const RecordView& record,
     return AnyHitOutcome::Accept;
 }
 
-// The state an intersection shader's ReportHit needs, reached through the invocation.
-struct ProceduralCandidate {
-    const RecordView* record = nullptr;
-    bool opaque = true;
-};
-
 }  // namespace
 
-// ReportHit (IS-3..IS-9): the body behind ShaderContext::ReportHit.
-bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attributes, TypeTag type,
-               const ProceduralCandidate& pc);
-
-namespace {
-thread_local const ProceduralCandidate* currentProcedural = nullptr;
-}
-
-bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attributes, TypeTag type,
-               const ProceduralCandidate& pc) {
+// ReportHit (IS-3..IS-9): the body behind ShaderContext::ReportHit. `inv` is the intersection
+// shader's invocation: its record is the hit group, its candidateOpaque the box's OPQ-1 opacity.
+bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attributes, TypeTag type) {
     ThreadState& ts = *inv.thread;
     RayState& rs = *inv.ray;
     const Site site = siteOf(inv);
-    const ProgramEntry& group = *pc.record->entry;
+    const ProgramEntry& group = *inv.record->entry;
     if (std::isnan(tHit)) {
         raise(ts, site, diag("IS-3", "ReportHit called with a NaN THit; the hit is rejected").value("THit", tHit));
         return false;
@@ -340,8 +327,8 @@ bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attrib
     candidate.attributeType = type;
     std::memcpy(candidate.attributes, attributes, type.size);
 
-    if (!pc.opaque && group.anyHit) {  // IS-7: the AHS runs inside ReportHit
-        switch (runAnyHit(ts, rs, *pc.record, candidate)) {
+    if (!inv.candidateOpaque && group.anyHit) {  // IS-7: the AHS runs inside ReportHit
+        switch (runAnyHit(ts, rs, *inv.record, candidate)) {
             case AnyHitOutcome::Ignore: return false;
             case AnyHitOutcome::AcceptAndEnd: commit(rs, candidate); throw EndSearchSignal{};
             case AnyHitOutcome::Accept: break;
@@ -442,19 +429,13 @@ void processProcedural(ThreadState& ts, RayState& rs, const Candidate& c, const 
     inv.dispatch = ts.dispatch;
     inv.thread = &ts;
     inv.depth = rs.depth;
+    inv.candidateOpaque = opaque;
     checkGlobalSignature(ts, siteOf(inv), *record.entry);
-    const ProceduralCandidate pc{&record, opaque};
-    const ProceduralCandidate* outer = currentProcedural;
-    currentProcedural = &pc;
     try {
         invoke(ts, inv, nullptr, nullptr);
     } catch (const EndSearchSignal&) {
         rs.searchEnded = true;  // IS-6/IS-7/FLAG-8: the IS ended at the accepting ReportHit
-    } catch (...) {
-        currentProcedural = outer;
-        throw;
     }
-    currentProcedural = outer;
 }
 
 // Orders candidates per DispatchOptions::order (GEN-3).
@@ -739,7 +720,6 @@ void callShader(Invocation& caller, uint32_t shaderIndex, void* parameters, Type
     std::memcpy(parameters, copy, type.size);
 }
 
-const ProceduralCandidate* currentProceduralCandidate() { return currentProcedural; }
 
 }  // namespace detail
 
@@ -797,7 +777,7 @@ uint32_t ShaderContext::HitKind() const {
 
 bool ShaderContext::reportHit(float tHit, uint32_t hitKind, const void* attributes, TypeTag type) {
     requireStage(bit(ShaderStage::Intersection), "ReportHit");
-    return detail::reportHit(inv_, tHit, hitKind, attributes, type, *detail::currentProceduralCandidate());
+    return detail::reportHit(inv_, tHit, hitKind, attributes, type);
 }
 
 void ShaderContext::IgnoreHit() {

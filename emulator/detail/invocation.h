@@ -67,6 +67,7 @@ struct Invocation {
     DispatchState* dispatch = nullptr;
     ThreadState* thread = nullptr;
     uint32_t depth = 0;
+    bool candidateOpaque = true;  // IS: the OPQ-1 opacity of the box, which ReportHit applies
 };
 
 }  // namespace refray::dxr::detail
