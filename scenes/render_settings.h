@@ -3,11 +3,13 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 
 #include "core/image.h"
 #include "core/progress.h"
 #include "emulator/dispatcher.h"
+#include "procedural/precision.h"
 
 namespace refray::scenes {
 
@@ -19,6 +21,14 @@ struct RenderSettings {
     uint64_t adversarialSeed = 0;
     dxr::OnError onError = dxr::OnError::Stop;
     Progress::Sink progress;  // optional
+    // Scene files only (the built-in scene has one camera, no time and no precision choice).
+    std::string camera;         // empty: the scene's default camera
+    std::optional<float> time;  // empty: the scene's default time
+    procedural::Precision precision = procedural::Precision::Float;
+    // Samples per pixel: a square number n = k·k renders a k-times larger dispatch whose k x k pixel centres
+    // fall on a regular grid inside each output pixel, averaged in float (the shaders' own ray generation runs
+    // unchanged). 1 is the GPU's image.
+    uint32_t spp = 1;
 };
 
 struct RenderResult {

@@ -2,6 +2,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <memory>
+#include <optional>
 #include <regex>
 #include <string>
 #include <unistd.h>
@@ -11,7 +13,9 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "emulator/validation.h"
+#include "procedural/precision.h"
 #include "scenes/builtin_scene.h"
+#include "scenes/scene.h"
 #include "tools/version.h"
 
 namespace {
@@ -54,34 +58,67 @@ void printStats(const scenes::RenderResult& r, const Size& size) {
     std::printf("  candidates gathered: %llu\n", (unsigned long long)st.candidates);
 }
 
-int runRender(const std::string& output, const std::string& sizeText, uint32_t threads, bool stats,
-              const std::string& order, uint64_t seed) {
-    const Size size = parseSize(sizeText);
+struct RenderOptions {
+    std::string scene;
+    std::string output = "refray.png";
+    std::string size;  // empty: the scene's image size
+    uint32_t threads = 0;
+    bool stats = false;
+    std::string order = "ordered";
+    uint64_t seed = 0;
+    std::string camera;
+    std::optional<float> time;
+    std::string precision = "float";
+    uint32_t spp = 1;
+};
+
+void writeOutput(const std::string& path, const Image& image) {
+    const auto parent = std::filesystem::path(path).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent);
+    writeImage(path, image);
+}
+
+int runRender(const RenderOptions& o) {
     scenes::RenderSettings settings;
-    settings.width = size.width;
-    settings.height = size.height;
-    settings.threads = threads;
-    settings.adversarialSeed = seed;
-    REFRAY_CHECK(order == "ordered" || order == "adversarial",
-                 "--order expects 'ordered' or 'adversarial', got '" << order << "'");
-    settings.order = order == "adversarial" ? dxr::TraversalOrder::Adversarial : dxr::TraversalOrder::Ordered;
+    settings.threads = o.threads;
+    settings.adversarialSeed = o.seed;
+    REFRAY_CHECK(o.order == "ordered" || o.order == "adversarial",
+                 "--order expects 'ordered' or 'adversarial', got '" << o.order << "'");
+    settings.order = o.order == "adversarial" ? dxr::TraversalOrder::Adversarial : dxr::TraversalOrder::Ordered;
     settings.progress = terminalProgress();
+    settings.camera = o.camera;
+    settings.time = o.time;
+    const std::optional<procedural::Precision> precision = procedural::parsePrecision(o.precision);
+    REFRAY_CHECK(precision, "--precision expects 'float' or 'double', got '" << o.precision << "'");
+    settings.precision = *precision;
+    settings.spp = o.spp;
 
-    scenes::BuiltinScene scene;
-    scenes::RenderResult result = scene.render(settings);
+    scenes::RenderResult result;
+    if (o.scene == "builtin") {
+        REFRAY_CHECK(o.camera.empty() && !o.time && o.spp == 1 && o.precision == "float",
+                     "the built-in scene has one camera, no time, one sample per pixel and float shaders; "
+                     "--camera, --time, --spp and --precision are for scene files");
+        const Size size = parseSize(o.size.empty() ? "640x360" : o.size);
+        settings.width = size.width, settings.height = size.height;
+        scenes::BuiltinScene scene;
+        result = scene.render(settings);
+        result.image.metadata["scene"] = "builtin";
+        result.image.metadata["size"] = std::to_string(size.width) + "x" + std::to_string(size.height);
+        result.image.metadata["traversal_order"] = o.order;
+    } else {
+        std::unique_ptr<scenes::Scene> scene = scenes::loadScene(o.scene);
+        const Size size = o.size.empty() ? Size{scene->desc().defaultWidth, scene->desc().defaultHeight} : parseSize(o.size);
+        settings.width = size.width, settings.height = size.height;
+        result = scene->render(settings);
+    }
     for (const auto& w : result.dispatch.diagnostics.warnings()) std::fprintf(stderr, "%s\n", w.format().c_str());
-
-    result.image.metadata["scene"] = "builtin";
     result.image.metadata["refray_version"] = tools::kVersion;
     result.image.metadata["refray_commit"] = tools::kCommit;
-    result.image.metadata["size"] = sizeText;
-    result.image.metadata["traversal_order"] = order;
+    result.image.metadata["threads"] = std::to_string(o.threads);
     result.image.metadata["render_seconds"] = std::to_string(result.dispatch.seconds);
-    const auto parent = std::filesystem::path(output).parent_path();
-    if (!parent.empty()) std::filesystem::create_directories(parent);
-    writeImage(output, result.image);
-    if (stats) printStats(result, size);
-    std::printf("wrote %s\n", output.c_str());
+    writeOutput(o.output, result.image);
+    if (o.stats) printStats(result, {result.image.width(), result.image.height()});
+    std::printf("wrote %s\n", o.output.c_str());
     return 0;
 }
 
@@ -92,21 +129,29 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     app.set_version_flag("--version", std::string(refray::tools::kVersion) + " (" + refray::tools::kCommit + ")");
 
-    auto* render = app.add_subcommand("render", "Render the built-in scene to an image (PNG or EXR)");
-    std::string output = "refray.png", size = "640x360", order = "ordered";
-    uint32_t threads = 0;
-    uint64_t seed = 0;
-    bool stats = false;
-    render->add_option("-o,--output", output, "Output image (.png: R8G8B8A8_UNORM as the GPU stores it; .exr: float)");
-    render->add_option("--size", size, "Image size WIDTHxHEIGHT")->capture_default_str();
-    render->add_option("--threads", threads, "Worker threads (0: all)")->capture_default_str();
-    render->add_option("--order", order, "Traversal order: ordered (default) or adversarial (GEN-3)");
-    render->add_option("--seed", seed, "Seed of the adversarial order");
-    render->add_flag("--stats", stats, "Print rays, invocations and timing");
+    auto* render = app.add_subcommand("render", "Render a scene file (or 'builtin') to an image (PNG or EXR)");
+    RenderOptions ro;
+    render->add_option("scene", ro.scene, "Scene file (e.g. scenes/proceduray-mandel-julia-pac.json), or 'builtin'")
+        ->required();
+    render->add_option("-o,--output", ro.output,
+                       "Output image (.png: R8G8B8A8_UNORM as the GPU stores it; .exr: the floats the shaders wrote)")
+        ->capture_default_str();
+    render->add_option("--size", ro.size, "Image size WIDTHxHEIGHT (default: the scene's imageSize)");
+    render->add_option("--camera", ro.camera, "Camera name (default: the scene's defaultCamera)");
+    render->add_option("--time", ro.time, "Animation time in seconds (default: the scene's default time)");
+    render->add_option("--precision", ro.precision, "Shader math precision: float (the GPU's) or double")
+        ->capture_default_str();
+    render->add_option("--spp", ro.spp, "Samples per pixel: a square number (k x k pixel centres of a k-times larger "
+                                        "dispatch, averaged)")
+        ->capture_default_str();
+    render->add_option("--threads", ro.threads, "Worker threads (0: all)")->capture_default_str();
+    render->add_option("--order", ro.order, "Traversal order: ordered (default) or adversarial (GEN-3)");
+    render->add_option("--seed", ro.seed, "Seed of the adversarial order");
+    render->add_flag("--stats", ro.stats, "Print rays, invocations and timing");
 
     try {
         app.parse(argc, argv);
-        if (*render) return runRender(output, size, threads, stats, order, seed);
+        if (*render) return runRender(ro);
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
     } catch (const refray::dxr::DxrError& e) {

@@ -37,7 +37,7 @@ std::string outputPath(const std::string& name) {
 TEST(RefrayCli, RenderWritesAPngWithProvenance) {
     const std::string path = outputPath("cli.png");
     std::filesystem::remove(path);
-    const CliRun r = run("render -o " + path + " --size 64x36 --threads 2 --stats");
+    const CliRun r = run("render builtin -o " + path + " --size 64x36 --threads 2 --stats");
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("rays at depth 1: 2304"), std::string::npos) << r.output;
     const refray::Image image = refray::readImage(path);
@@ -50,24 +50,71 @@ TEST(RefrayCli, RenderWritesAPngWithProvenance) {
 
 TEST(RefrayCli, ExrKeepsFloats) {
     const std::string path = outputPath("cli.exr");
-    ASSERT_EQ(run("render -o " + path + " --size 32x18").status, 0);
+    ASSERT_EQ(run("render builtin -o " + path + " --size 32x18").status, 0);
     EXPECT_EQ(refray::readImage(path).width(), 32u);
 }
 
 TEST(RefrayCli, BadSizeIsAClearError) {
-    const CliRun r = run("render -o " + outputPath("bad.png") + " --size 64by36");
+    const CliRun r = run("render builtin -o " + outputPath("bad.png") + " --size 64by36");
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.output.find("--size expects WIDTHxHEIGHT"), std::string::npos) << r.output;
 }
 
 TEST(RefrayCli, UnknownOrderIsAClearError) {
-    const CliRun r = run("render -o " + outputPath("bad.png") + " --size 8x8 --order random");
+    const CliRun r = run("render builtin -o " + outputPath("bad.png") + " --size 8x8 --order random");
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.output.find("--order expects"), std::string::npos) << r.output;
 }
 
 TEST(RefrayCli, UnwritablePathNamesIt) {
-    const CliRun r = run("render -o /proc/refray-cannot-write.png --size 8x8");
+    const CliRun r = run("render builtin -o /proc/refray-cannot-write.png --size 8x8");
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.output.find("/proc/refray-cannot-write.png"), std::string::npos) << r.output;
+}
+
+TEST(RefrayCli, RendersASceneFileWithProvenance) {
+    const std::string path = outputPath("proceduray.exr");
+    std::filesystem::remove(path);
+    const CliRun r = run("render " + std::string(REFRAY_SOURCE_DIR) +
+                         "/scenes/proceduray-mandel-julia-pac.json -o " + path +
+                         " --size 40x24 --camera julia --time 0 --precision double --threads 2");
+    ASSERT_EQ(r.status, 0) << r.output;
+    const refray::Image image = refray::readImage(path);
+    EXPECT_EQ(image.width(), 40u);
+    EXPECT_EQ(image.metadata.at("scene"), "proceduray-mandel-julia-pac");
+    EXPECT_EQ(image.metadata.at("camera"), "julia");
+    EXPECT_EQ(image.metadata.at("time"), "0");
+    EXPECT_EQ(image.metadata.at("precision"), "double");
+    EXPECT_EQ(image.metadata.at("scene_sha256").size(), 64u);
+    EXPECT_TRUE(image.metadata.count("render_seconds"));
+    EXPECT_TRUE(image.metadata.count("refray_version"));
+}
+
+TEST(RefrayCli, BrokenSceneFileNamesFileLineAndColumn) {
+    const std::string scene = outputPath("broken-scene.json");
+    {
+        std::FILE* f = std::fopen(scene.c_str(), "w");
+        ASSERT_NE(f, nullptr);
+        std::fputs("{\n  \"format\": \"refray-scene/1\",\n  \"nmae\": \"x\"\n}\n", f);
+        std::fclose(f);
+    }
+    const CliRun r = run("render " + scene + " -o " + outputPath("never.png"));
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("broken-scene.json:1:1: the scene has no 'name'"), std::string::npos) << r.output;
+}
+
+TEST(RefrayCli, SceneOptionsAreCheckedByName) {
+    const std::string scene = std::string(REFRAY_SOURCE_DIR) + "/scenes/d3d12-procedural-geometry.json";
+    CliRun r = run("render " + scene + " -o " + outputPath("never.png") + " --size 8x8 --camera front");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("has no camera 'front'"), std::string::npos) << r.output;
+    r = run("render " + scene + " -o " + outputPath("never.png") + " --size 8x8 --precision half");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("--precision expects 'float' or 'double'"), std::string::npos) << r.output;
+    r = run("render " + scene + " -o " + outputPath("never.png") + " --size 8x8 --spp 2");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("--spp must be a square number"), std::string::npos) << r.output;
+    r = run("render no-such-scene.json -o " + outputPath("never.png"));
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.output.find("cannot read scene file no-such-scene.json"), std::string::npos) << r.output;
 }

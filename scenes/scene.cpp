@@ -1,0 +1,318 @@
+#include "scenes/scene.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstring>
+
+#include "core/error.h"
+#include "scenes/scene_loader.h"
+
+namespace refray::scenes {
+
+using namespace refray::dxr;
+using procedural::Float4x4;
+using procedural::Precision;
+
+namespace {
+
+// A DXR 3x4 (column-vector) transform in the row-vector float4x4 form HLSL /Zpr shaders read.
+Float4x4 rowVectorForm(const Matrix3x4& m) {
+    Float4x4 r;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) r.m[size_t(i)][size_t(j)] = m.m[size_t(j)][size_t(i)];
+    r.m[3] = {m.m[0][3], m.m[1][3], m.m[2][3], 1.0f};
+    return r;
+}
+
+using DMat4 = std::array<std::array<double, 4>, 4>;
+
+DMat4 multiply(const DMat4& a, const DMat4& b) {
+    DMat4 r{};
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j)
+            for (int k = 0; k < 4; ++k) r[size_t(i)][size_t(j)] += a[size_t(i)][size_t(k)] * b[size_t(k)][size_t(j)];
+    return r;
+}
+
+Float4x4 toFloat(const DMat4& m) {
+    Float4x4 r;
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) r.m[size_t(i)][size_t(j)] = float(m[size_t(i)][size_t(j)]);
+    return r;
+}
+
+// S·R·Tr of an element of a primitiveTransforms buffer and its inverse Tr⁻¹·Rᵀ·S⁻¹, in double.
+std::pair<Float4x4, Float4x4> primitiveTransform(const PrimitiveTransformDesc& p, double time) {
+    const double theta = p.spinYPerSecond * time;
+    const double c = std::cos(theta), s = std::sin(theta);
+    const DMat4 R = {{{c, 0, -s, 0}, {0, 1, 0, 0}, {s, 0, c, 0}, {0, 0, 0, 1}}};
+    const DMat4 Rt = {{{c, 0, s, 0}, {0, 1, 0, 0}, {-s, 0, c, 0}, {0, 0, 0, 1}}};
+    DMat4 S{}, Si{}, T{}, Ti{};
+    for (int k = 0; k < 4; ++k) S[size_t(k)][size_t(k)] = Si[size_t(k)][size_t(k)] = T[size_t(k)][size_t(k)] = Ti[size_t(k)][size_t(k)] = 1;
+    for (int k = 0; k < 3; ++k) {
+        S[size_t(k)][size_t(k)] = p.scale[k];
+        Si[size_t(k)][size_t(k)] = 1.0 / double(p.scale[k]);
+        T[3][size_t(k)] = p.centre[k];
+        Ti[3][size_t(k)] = -double(p.centre[k]);
+    }
+    return {toFloat(multiply(multiply(S, R), T)), toFloat(multiply(multiply(Ti, Rt), Si))};
+}
+
+uint32_t sampleGridSize(uint32_t spp) {
+    const uint32_t k = uint32_t(std::lround(std::sqrt(double(spp))));
+    REFRAY_CHECK(spp >= 1 && k * k == spp && k <= 16,
+                 "--spp must be a square number from 1 to 256 (1, 4, 9, 16, ...): the samples are a k x k grid of "
+                 "pixel centres of a k-times larger dispatch; got "
+                     << spp);
+    return k;
+}
+
+}  // namespace
+
+Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
+    GpuMemory& memory = device_.memory();
+
+    // Data buffers.
+    bufferAddresses_.resize(desc_.buffers.size(), 0);
+    for (size_t i = 0; i < desc_.buffers.size(); ++i) {
+        const BufferDesc& b = desc_.buffers[i];
+        if (b.kind == BufferDesc::Kind::Data) bufferAddresses_[i] = memory.upload(b.bytes.data(), b.bytes.size(), b.name);
+    }
+
+    // One BLAS per bottom-level entry, geometries in file order (GeometryIndex, IDX-4).
+    for (const BlasDesc& blas : desc_.blases) {
+        BottomLevelInputs inputs;
+        inputs.Flags = blas.buildFlags;
+        for (const GeometryDescFile& g : blas.geometries) {
+            GeometryDesc d;
+            d.Type = g.type;
+            d.Flags = g.flags;
+            if (g.type == GeometryType::Triangles) {
+                d.Triangles.VertexBuffer = {bufferAddresses_[g.vertexBuffer] + g.vertexOffset, g.vertexStride};
+                d.Triangles.VertexCount = g.vertexCount;
+                d.Triangles.VertexFormat = g.vertexFormat;
+                if (g.indexBuffer >= 0) {
+                    d.Triangles.IndexBuffer = bufferAddresses_[size_t(g.indexBuffer)] + g.indexOffset;
+                    d.Triangles.IndexCount = g.indexCount;
+                    d.Triangles.IndexFormat = g.indexFormat;
+                }
+            } else {
+                d.AABBs.AABBCount = g.aabbCount;
+                d.AABBs.AABBs = {bufferAddresses_[g.aabbBuffer], sizeof(RaytracingAABB)};
+            }
+            inputs.GeometryDescs.push_back(d);
+        }
+        blasAddresses_.push_back(device_.buildBottomLevelAS(inputs));
+    }
+
+    // The TLAS, instances in file order (InstanceIndex).
+    std::vector<InstanceDesc> instances;
+    for (const InstanceDescFile& i : desc_.instances)
+        instances.push_back(
+            makeInstanceDesc(i.transform, i.instanceID, i.mask, i.contribution, i.flags, blasAddresses_[i.blas]));
+    tlas_ = device_.buildTopLevelAS({BUILD_FLAG_PREFER_FAST_TRACE, uint32_t(instances.size()), ElementsLayout::Array,
+                                     memory.upload(instances, desc_.name + " instance descs")});
+
+    // Root signatures and the descriptor heap for the global tables.
+    globalSignature_ = RootSignature::create(desc_.globalSignature);
+    for (const RootSignatureDesc& l : desc_.localSignatures) localSignatures_.push_back(RootSignature::create(l));
+    for (const GlobalArgumentDesc& a : desc_.globalArguments) heapSize_ += uint32_t(a.table.size());
+    if (heapSize_ > 0) heap_ = &device_.createDescriptorHeap(heapSize_, desc_.name + " descriptor heap");
+
+    pipelineFor(Precision::Float);  // validates the state object and the tables now
+}
+
+Scene::Pipeline& Scene::pipelineFor(Precision precision) {
+    if (auto it = pipelines_.find(precision); it != pipelines_.end()) return it->second;
+    const ShaderLibraryBinding& binding = findShaderLibrary(desc_.shaderLibrary);
+
+    StateObjectDesc so;
+    so.name = desc_.name + " (" + std::string(procedural::toString(precision)) + ")";
+    so.libraries = {{binding.make(precision), {}}};
+    so.hitGroups = desc_.hitGroups;
+    for (size_t i = 0; i < localSignatures_.size(); ++i)
+        if (!desc_.localAssociations[i].empty())
+            so.localRootSignatures.push_back({localSignatures_[i], desc_.localAssociations[i]});
+    so.globalRootSignatures = {{globalSignature_, {}}};
+    so.shaderConfigs = {{desc_.maxPayloadBytes, desc_.maxAttributeBytes}};
+    so.pipelineConfigs = {{desc_.maxRecursionDepth, PIPELINE_FLAG_NONE}};
+    Pipeline p;
+    p.stateObject = StateObject::create(so);
+
+    GpuMemory& memory = device_.memory();
+    const auto rayGen =
+        ShaderTableBuilder("raygen").addRecord(p.stateObject->shaderIdentifier(desc_.rayGeneration)).upload(memory);
+    p.tables.RayGenerationShaderRecord = {rayGen.StartAddress, rayGen.SizeInBytes};
+    ShaderTableBuilder miss("miss");
+    for (const std::string& m : desc_.missRecords)
+        miss.addRecord(m.empty() ? ShaderIdentifier{} : p.stateObject->shaderIdentifier(m));
+    p.tables.MissShaderTable = miss.upload(memory);
+    ShaderTableBuilder hitGroups("hit groups");
+    for (const RecordDesc& r : desc_.hitGroupRecords) {
+        const ShaderIdentifier id = r.hitGroup.empty() ? ShaderIdentifier{} : p.stateObject->shaderIdentifier(r.hitGroup);
+        if (r.localRootSignature < 0) {
+            hitGroups.addRecord(id);
+            continue;
+        }
+        LocalRootArguments args(localSignatures_[size_t(r.localRootSignature)]);
+        for (const RecordDesc::Argument& a : r.arguments) {
+            if (a.buffer >= 0) {
+                // Generated buffers have no fixed address; local root descriptors must point at data.
+                REFRAY_CHECK(desc_.buffers[size_t(a.buffer)].kind == BufferDesc::Kind::Data,
+                             json::toString(r.where) << ": " << r.origin << " binds generated buffer '"
+                                                     << desc_.buffers[size_t(a.buffer)].name
+                                                     << "' as a local root descriptor; records are written once, so "
+                                                        "they can only point at data buffers");
+                args.setDescriptor(a.parameter, bufferAddresses_[size_t(a.buffer)]);
+            } else {
+                args.setConstantBytes(a.parameter, a.dwords.data(), uint32_t(a.dwords.size() * 4));
+            }
+        }
+        hitGroups.addRecord(id, args);
+    }
+    p.tables.HitGroupTable = hitGroups.upload(memory, desc_.hitGroupStride ? desc_.hitGroupStride : ~0ull);
+    return pipelines_.emplace(precision, std::move(p)).first->second;
+}
+
+GpuVirtualAddress Scene::generateBuffer(const BufferDesc& b, const RenderSettings& settings, float time, uint32_t width,
+                                        uint32_t height) {
+    GpuMemory& memory = device_.memory();
+    switch (b.kind) {
+        case BufferDesc::Kind::SceneConstants: {
+            const CameraDesc& camera = desc_.camera(settings.camera);
+            SceneConstantsInput in;
+            in.projectionToWorld = projectionToWorld(camera, width, height);
+            in.cameraPosition = vec4(vec3(camera.eye), 1.0f);
+            in.light = desc_.light;
+            in.elapsedTime = time;
+            in.debugFlag = b.debugFlag;
+            const std::vector<uint8_t> bytes = findShaderLibrary(desc_.shaderLibrary).sceneConstants(in);
+            return memory.upload(bytes, b.name);
+        }
+        case BufferDesc::Kind::InstanceTransforms: {
+            std::vector<Float4x4> matrices;
+            for (uint32_t i : b.instances) {
+                const InstanceDescFile& inst = desc_.instances[i];
+                const std::optional<Matrix3x4> inverse = affineInverse(inst.transform);
+                REFRAY_CHECK(inverse, json::toString(inst.where) << ": instance '" << inst.name
+                                                                 << "' has a singular transform, so buffer '" << b.name
+                                                                 << "' cannot hold its inverse");
+                matrices.push_back(rowVectorForm(*inverse));      // world -> object
+                matrices.push_back(rowVectorForm(inst.transform));  // object -> world
+            }
+            return memory.upload(matrices, b.name);
+        }
+        case BufferDesc::Kind::PrimitiveTransforms: {
+            std::vector<Float4x4> matrices;
+            for (const PrimitiveTransformDesc& p : b.primitives) {
+                const auto [forward, inverse] = primitiveTransform(p, double(time));
+                matrices.push_back(forward);
+                matrices.push_back(inverse);
+            }
+            return memory.upload(matrices, b.name);
+        }
+        case BufferDesc::Kind::Data: break;
+    }
+    REFRAY_ASSERT(false, "buffer '" << b.name << "' is not generated");
+    return 0;
+}
+
+RenderResult Scene::render(const RenderSettings& settings) {
+    const uint32_t k = sampleGridSize(settings.spp);
+    const uint32_t width = settings.width * k, height = settings.height * k;
+    REFRAY_CHECK(settings.width > 0 && settings.height > 0 && width <= 65536 && height <= 65536,
+                 "the dispatch " << width << "x" << height << " (size x sqrt(spp)) is outside 1x1 .. 65536x65536");
+    const float time = settings.time.value_or(desc_.defaultTime);
+    REFRAY_CHECK(std::isfinite(time) && time >= 0.0f, "--time must be a finite, non-negative number of seconds, got " << time);
+    const CameraDesc& camera = desc_.camera(settings.camera);
+    Pipeline& pipeline = pipelineFor(settings.precision);
+
+    Image target(width, height);
+    std::vector<GpuVirtualAddress> frameAddresses(desc_.buffers.size(), 0);
+    for (size_t i = 0; i < desc_.buffers.size(); ++i)
+        frameAddresses[i] = desc_.buffers[i].kind == BufferDesc::Kind::Data
+                                ? bufferAddresses_[i]
+                                : generateBuffer(desc_.buffers[i], settings, time, width, height);
+
+    GlobalRootArguments globals(globalSignature_);
+    uint32_t slot = 0;
+    for (const GlobalArgumentDesc& a : desc_.globalArguments) {
+        switch (a.kind) {
+            case GlobalArgumentDesc::Kind::AccelerationStructure: globals.setDescriptor(a.parameter, tlas_); break;
+            case GlobalArgumentDesc::Kind::Buffer: globals.setDescriptor(a.parameter, frameAddresses[size_t(a.buffer)]); break;
+            case GlobalArgumentDesc::Kind::Table:
+                globals.setDescriptor(a.parameter, heap_->gpuHandle(slot));
+                for (const GlobalArgumentDesc::TableEntry& e : a.table) {
+                    if (e.renderTarget) {
+                        heap_->setTexture2D(slot++, DescriptorRangeType::UAV, &target);
+                        continue;
+                    }
+                    const BufferDesc& b = desc_.buffers[size_t(e.buffer)];
+                    const uint64_t size = b.kind == BufferDesc::Kind::Data ? b.bytes.size()
+                                                                           : device_.memory().find(frameAddresses[size_t(e.buffer)])->size();
+                    heap_->setBuffer(slot++, e.type, {frameAddresses[size_t(e.buffer)], size, e.stride});
+                }
+                break;
+        }
+    }
+
+    DispatchRaysDesc desc = pipeline.tables;
+    desc.Width = width;
+    desc.Height = height;
+    desc.Depth = 1;
+    DispatchOptions options;
+    options.threads = settings.threads;
+    options.order = settings.order;
+    options.adversarialSeed = settings.adversarialSeed;
+    options.onError = settings.onError;
+    std::unique_ptr<Progress> progress;
+    if (settings.progress) {
+        progress = std::make_unique<Progress>("render", uint64_t(width) * height, settings.progress);
+        options.progress = progress.get();
+    }
+    RenderResult result;
+    result.dispatch = device_.dispatchRays(desc, pipeline.stateObject, &globals, options);
+    if (progress) progress->finish();
+
+    // k x k samples per output pixel, averaged in float in a fixed order (deterministic).
+    if (k == 1) {
+        result.image = std::move(target);
+    } else {
+        result.image = Image(settings.width, settings.height);
+        const float weight = 1.0f / float(k * k);
+        for (uint32_t y = 0; y < settings.height; ++y)
+            for (uint32_t x = 0; x < settings.width; ++x) {
+                vec4 sum(0.0f);
+                for (uint32_t j = 0; j < k; ++j)
+                    for (uint32_t i = 0; i < k; ++i) sum += target.at(x * k + i, y * k + j);
+                result.image.at(x, y) = sum * weight;
+            }
+    }
+
+    auto& meta = result.image.metadata;
+    meta["scene"] = desc_.name;
+    meta["scene_file"] = desc_.file.filename().string();
+    meta["scene_sha256"] = desc_.fileHash;
+    meta["shader_library"] = desc_.shaderLibrary;
+    meta["camera"] = camera.name;
+    if (!settings.time || *settings.time == desc_.defaultTime) {
+        meta["time"] = desc_.defaultTimeText;  // as the scene file writes it
+    } else {
+        char text[32];
+        const auto end = std::to_chars(text, text + sizeof text, time);  // shortest text that reads back as `time`
+        meta["time"] = std::string(text, end.ptr);
+    }
+    meta["precision"] = std::string(procedural::toString(settings.precision));
+    meta["spp"] = std::to_string(settings.spp);
+    meta["size"] = std::to_string(settings.width) + "x" + std::to_string(settings.height);
+    meta["traversal_order"] = settings.order == TraversalOrder::Ordered
+                                  ? "ordered"
+                                  : "adversarial seed " + std::to_string(settings.adversarialSeed);
+    return result;
+}
+
+std::unique_ptr<Scene> loadScene(const std::filesystem::path& path) {
+    return std::make_unique<Scene>(loadSceneFile(path));
+}
+
+}  // namespace refray::scenes

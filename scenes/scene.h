@@ -1,0 +1,53 @@
+// A scene file turned into DXR objects: one device with the BLASes, the TLAS and the data buffers, and per
+// precision a state object with its shader tables. Renders any camera, time, size and sample count.
+#pragma once
+
+#include <map>
+#include <memory>
+
+#include "emulator/device.h"
+#include "scenes/render_settings.h"
+#include "scenes/scene_desc.h"
+
+namespace refray::scenes {
+
+class Scene {
+public:
+    // Builds everything the scene describes; DXR validation errors (DxrError) name the rule.
+    explicit Scene(SceneDesc desc);
+
+    // Throws refray::Error for an unknown camera or a bad sample count.
+    RenderResult render(const RenderSettings& settings);
+
+    const SceneDesc& desc() const { return desc_; }
+    dxr::Device& device() { return device_; }
+    dxr::GpuVirtualAddress tlas() const { return tlas_; }
+    // The state object and tables of `precision` (built on first use).
+    const dxr::StateObjectPtr& pipeline(procedural::Precision precision) { return pipelineFor(precision).stateObject; }
+    const dxr::DispatchRaysDesc& tables(procedural::Precision precision) { return pipelineFor(precision).tables; }
+
+private:
+    struct Pipeline {
+        dxr::StateObjectPtr stateObject;
+        dxr::DispatchRaysDesc tables;
+    };
+    Pipeline& pipelineFor(procedural::Precision precision);
+    dxr::GpuVirtualAddress generateBuffer(const BufferDesc& buffer, const RenderSettings& settings, float time,
+                                          uint32_t width, uint32_t height);
+
+    SceneDesc desc_;
+    dxr::Device device_;
+    std::vector<dxr::GpuVirtualAddress> bufferAddresses_;  // data buffers (0 for generated ones)
+    std::vector<dxr::GpuVirtualAddress> blasAddresses_;
+    dxr::GpuVirtualAddress tlas_ = 0;
+    dxr::RootSignaturePtr globalSignature_;
+    std::vector<dxr::RootSignaturePtr> localSignatures_;
+    std::map<procedural::Precision, Pipeline> pipelines_;
+    dxr::DescriptorHeap* heap_ = nullptr;
+    uint32_t heapSize_ = 0;
+};
+
+// Loads, validates and builds a scene file.
+std::unique_ptr<Scene> loadScene(const std::filesystem::path& path);
+
+}  // namespace refray::scenes
