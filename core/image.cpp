@@ -44,6 +44,9 @@ void writeImage(const std::string& path, const Image& image) {
                          asFloat ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
     for (const auto& [key, value] : image.metadata) spec.attribute(kMetadataPrefix + key, value);
     if (ext == ".exr") spec.attribute("compression", "zip");
+    // A render target's alpha is just a fourth channel: store the colour bytes as they are, not divided by alpha
+    // (OpenImageIO would otherwise treat our values as premultiplied and un-premultiply them for PNG).
+    spec.attribute("oiio:UnassociatedAlpha", 1);
     REFRAY_CHECK(out->open(path, spec), "cannot open '" << path << "' for writing: " << out->geterror());
 
     bool ok = false;
@@ -61,7 +64,10 @@ void writeImage(const std::string& path, const Image& image) {
 
 Image readImage(const std::string& path) {
     REFRAY_CHECK(std::filesystem::exists(path), "cannot read image '" << path << "': no such file");
-    auto in = OIIO::ImageInput::open(path);
+    // Read colour as stored, without premultiplying it by alpha (see writeImage).
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(path, &config);
     REFRAY_CHECK(in, "cannot read image '" << path << "': " << OIIO::geterror());
     const OIIO::ImageSpec& spec = in->spec();
     REFRAY_CHECK(spec.width > 0 && spec.height > 0 && spec.nchannels > 0,

@@ -631,6 +631,16 @@ void ObjectReader::noteAsked(std::string_view key) {
 const Value& ObjectReader::required(std::string_view key) {
     noteAsked(key);
     if (const Value* found = value_->find(key)) return *found;
+    // A present key that is close to the missing one is probably its misspelling: point at it.
+    std::vector<std::string> present;
+    const Member* misspelt = nullptr;
+    for (const Member& member : value_->asObject()) present.push_back(member.key);
+    if (const std::optional<std::string> close = closestMatch(key, present))
+        for (const Member& member : value_->asObject())
+            if (member.key == *close) misspelt = &member;
+    if (misspelt)
+        throw Error(toString(misspelt->keyLocation) + ": " + what_ + " has no '" + std::string(key) + "'; is '" +
+                    misspelt->key + "' a misspelling of it?");
     value_->fail(what_ + " has no '" + std::string(key) + "'");
 }
 

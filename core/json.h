@@ -122,6 +122,8 @@ public:
 
     const Value& value() const { return *value_; }
     const std::string& what() const { return what_; }
+    // Renames the object for later messages, e.g. once its "name" member has been read.
+    void setWhat(std::string what) { what_ = std::move(what); }
 
 private:
     void noteAsked(std::string_view key);

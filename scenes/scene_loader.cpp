@@ -250,7 +250,7 @@ private:
     // A constants argument: a named entry of "values" or an inline object, encoded with the parameter's struct.
     std::vector<uint32_t> constantValue(const Value& value, int32_t structIndex, uint32_t num32, const std::string& what) {
         if (structIndex < 0) {
-            // No struct: a flat array of 32-bit numbers (floats unless integral? no: explicit), given as numbers.
+            // No struct: a flat array of 32-bit floats (declare a struct for ints and uints).
             const auto& a = value.asArray();
             if (a.size() != num32)
                 value.fail(what + " needs " + std::to_string(num32) + " 32-bit values, got " + std::to_string(a.size()));
@@ -313,6 +313,7 @@ private:
             ObjectReader r(v, "a ray type");
             RayTypeDesc t;
             t.name = nonEmptyName(r.required("name"), "a ray type's name");
+            r.setWhat("ray type " + inQuotes(t.name));
             for (const RayTypeDesc& o : scene_.rayTypes)
                 if (o.name == t.name) v.fail("two ray types are named " + inQuotes(t.name));
             const Value& miss = r.required("miss");
@@ -340,6 +341,7 @@ private:
             ObjectReader r(v, "a hit group");
             dxr::HitGroupDesc g;
             g.HitGroupExport = nonEmptyName(r.required("name"), "a hit group's name");
+            r.setWhat("hit group " + inQuotes(g.HitGroupExport));
             if (std::find(hitGroupNames_.begin(), hitGroupNames_.end(), g.HitGroupExport) != hitGroupNames_.end())
                 v.fail("two hit groups are named " + inQuotes(g.HitGroupExport));
             if (library_->find(g.HitGroupExport))
@@ -664,6 +666,7 @@ private:
             ObjectReader r(v, "a bottom-level structure");
             BlasDesc blas;
             blas.name = nonEmptyName(r.required("name"), "a BLAS name");
+            r.setWhat("bottom-level structure " + inQuotes(blas.name));
             if (std::find(blasNames_.begin(), blasNames_.end(), blas.name) != blasNames_.end())
                 v.fail("two bottom-level structures are named " + inQuotes(blas.name));
             blas.where = v.location();
@@ -759,6 +762,7 @@ private:
             ObjectReader r(v, "an instance");
             InstanceDescFile inst;
             inst.name = nonEmptyName(r.required("name"), "an instance name");
+            r.setWhat("instance " + inQuotes(inst.name));
             if (std::find(instanceNames_.begin(), instanceNames_.end(), inst.name) != instanceNames_.end())
                 v.fail("two instances are named " + inQuotes(inst.name));
             inst.where = v.location();
@@ -914,7 +918,7 @@ private:
         if (const Value* s = r.optional("hitGroupStride")) {
             scene_.hitGroupStride = s->asUint32();
             if (scene_.hitGroupStride % 32 != 0 || scene_.hitGroupStride > 4096)
-                s->fail("a hit-group stride is a multiple of 32 up to 4096 (REC-2), got " + std::to_string(scene_.hitGroupStride));
+                s->fail("a hit-group stride is a multiple of 32 up to 4096 (REC-3), got " + std::to_string(scene_.hitGroupStride));
         }
         r.finish();
     }
@@ -1005,6 +1009,7 @@ private:
             ObjectReader r(v, "a camera");
             CameraDesc c;
             c.name = nonEmptyName(r.required("name"), "a camera name");
+            r.setWhat("camera " + inQuotes(c.name));
             if (std::find(names.begin(), names.end(), c.name) != names.end()) v.fail("two cameras are named " + inQuotes(c.name));
             const uint32_t model = resolveName(r.required("model"), {"miniengine", "directxmath-lh"}, "camera model");
             c.model = model == 0 ? CameraModel::MiniEngine : CameraModel::DirectXMathLH;

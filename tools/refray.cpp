@@ -15,7 +15,10 @@
 #include "emulator/validation.h"
 #include "procedural/precision.h"
 #include "scenes/builtin_scene.h"
+#include "scenes/golden.h"
+#include "scenes/order_check.h"
 #include "scenes/scene.h"
+#include "tools/compare_command.h"
 #include "tools/version.h"
 
 namespace {
@@ -70,7 +73,14 @@ struct RenderOptions {
     std::optional<float> time;
     std::string precision = "float";
     uint32_t spp = 1;
+    uint32_t orderCheck = 0;
 };
+
+// "out.png" -> "out.order-mask.png".
+std::string maskPath(const std::string& output) {
+    std::filesystem::path p(output);
+    return (p.parent_path() / (p.stem().string() + ".order-mask.png")).string();
+}
 
 void writeOutput(const std::string& path, const Image& image) {
     const auto parent = std::filesystem::path(path).parent_path();
@@ -95,9 +105,9 @@ int runRender(const RenderOptions& o) {
 
     scenes::RenderResult result;
     if (o.scene == "builtin") {
-        REFRAY_CHECK(o.camera.empty() && !o.time && o.spp == 1 && o.precision == "float",
+        REFRAY_CHECK(o.camera.empty() && !o.time && o.spp == 1 && o.precision == "float" && o.orderCheck == 0,
                      "the built-in scene has one camera, no time, one sample per pixel and float shaders; "
-                     "--camera, --time, --spp and --precision are for scene files");
+                     "--camera, --time, --spp, --precision and --order-check are for scene files");
         const Size size = parseSize(o.size.empty() ? "640x360" : o.size);
         settings.width = size.width, settings.height = size.height;
         scenes::BuiltinScene scene;
@@ -109,7 +119,19 @@ int runRender(const RenderOptions& o) {
         std::unique_ptr<scenes::Scene> scene = scenes::loadScene(o.scene);
         const Size size = o.size.empty() ? Size{scene->desc().defaultWidth, scene->desc().defaultHeight} : parseSize(o.size);
         settings.width = size.width, settings.height = size.height;
-        result = scene->render(settings);
+        if (o.orderCheck > 0) {
+            scenes::OrderCheckResult check = scenes::checkTraversalOrder(*scene, settings, o.orderCheck);
+            result = std::move(check.ordered);
+            const std::string mask = maskPath(o.output);
+            check.mask.metadata["refray_commit"] = tools::kCommit;
+            writeOutput(mask, check.mask);
+            std::printf("order check: %llu of %u pixels depend on the traversal order (ordered vs %u adversarial "
+                        "orders); mask: %s\n",
+                        (unsigned long long)check.orderDependentPixels, size.width * size.height, o.orderCheck,
+                        mask.c_str());
+        } else {
+            result = scene->render(settings);
+        }
     }
     for (const auto& w : result.dispatch.diagnostics.warnings()) std::fprintf(stderr, "%s\n", w.format().c_str());
     result.image.metadata["refray_version"] = tools::kVersion;
@@ -148,10 +170,47 @@ int main(int argc, char** argv) {
     render->add_option("--order", ro.order, "Traversal order: ordered (default) or adversarial (GEN-3)");
     render->add_option("--seed", ro.seed, "Seed of the adversarial order");
     render->add_flag("--stats", ro.stats, "Print rays, invocations and timing");
+    render->add_option("--order-check", ro.orderCheck,
+                       "Also render N seeded adversarial traversal orders (GEN-3) and write OUTPUT.order-mask.png: "
+                       "white where a pixel depends on the order");
+
+    refray::tools::CompareCommandOptions compareOptions;
+    CLI::App* compare = refray::tools::addCompareCommand(app, compareOptions);
+
+    auto* golden = app.add_subcommand("golden", "Golden images of every scene x camera (tests/golden/)");
+    golden->require_subcommand(1);
+    auto* update = golden->add_subcommand("update", "Re-render every golden, its order mask and the manifest");
+    std::string goldenDir = "tests/golden", goldenSize = "320x180", repositoryRoot = ".";
+    uint32_t goldenOrders = 4, goldenThreads = 0;
+    update->add_option("--dir", goldenDir, "Where the goldens go")->capture_default_str();
+    update->add_option("--root", repositoryRoot, "The repository root (holds scenes/)")->capture_default_str();
+    update->add_option("--size", goldenSize, "Golden size WIDTHxHEIGHT")->capture_default_str();
+    update->add_option("--order-check", goldenOrders, "Adversarial orders per golden")->capture_default_str();
+    update->add_option("--threads", goldenThreads, "Worker threads (0: all)")->capture_default_str();
 
     try {
         app.parse(argc, argv);
         if (*render) return runRender(ro);
+        if (*compare) return refray::tools::runCompare(compareOptions);
+        if (*update) {
+            const Size size = parseSize(goldenSize);
+            scenes::GoldenUpdateOptions options;
+            options.repositoryRoot = repositoryRoot;
+            options.goldenDirectory = goldenDir;
+            options.width = size.width;
+            options.height = size.height;
+            options.orders = goldenOrders;
+            options.threads = goldenThreads;
+            options.refrayCommit = refray::tools::kCommit;
+            options.onEntry = [](const scenes::GoldenEntry& e, double seconds) {
+                std::printf("%-48s %ux%u  %6.2f s  %llu order-dependent pixels\n", e.name.c_str(), e.width, e.height,
+                            seconds, (unsigned long long)e.orderDependentPixels);
+                std::fflush(stdout);
+            };
+            const scenes::GoldenSet set = scenes::updateGoldens(options);
+            std::printf("wrote %zu goldens and %s/goldens.json\n", set.entries.size(), goldenDir.c_str());
+            return 0;
+        }
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
     } catch (const refray::dxr::DxrError& e) {

@@ -58,3 +58,17 @@ TEST(Image, ReadingAMissingFileNamesIt) {
 TEST(Image, WritingAnUnknownExtensionIsAnError) {
     EXPECT_THROW(writeImage(outputPath("image.unknownext"), Image(1, 1)), Error);
 }
+
+TEST(Image, PngKeepsColourBytesWhateverTheAlpha) {
+    // A render target stores RGBA independently: alpha 0 or 0.5 must not change the stored colour.
+    refray::Image image(2, 1);
+    image.at(0, 0) = refray::vec4(0.2f, 0.4f, 0.6f, 0.5f);
+    image.at(1, 0) = refray::vec4(0.8f, 0.6f, 0.4f, 0.0f);
+    const std::string path = std::string(REFRAY_TEST_OUTPUT_DIR) + "/alpha.png";
+    std::filesystem::create_directories(REFRAY_TEST_OUTPUT_DIR);
+    refray::writeImage(path, image);
+    const refray::Image back = refray::readImage(path);
+    for (uint32_t x = 0; x < 2; ++x)
+        for (int c = 0; c < 4; ++c)
+            EXPECT_EQ(refray::floatToUnorm8(back.at(x, 0)[c]), refray::floatToUnorm8(image.at(x, 0)[c])) << x << " " << c;
+}

@@ -198,6 +198,11 @@ TEST(SceneLoader, BadRegisterAndCameraAreNamed) {
                     "unknown camera 'overveiw' (did you mean 'overview'?)");
 }
 
+TEST(SceneLoader, MisspeltRequiredKeyIsPointedAt) {
+    const std::string message = loadError(edited("\"eye\": [90, 5, 215]", "\"eyes\": [90, 5, 215]"));
+    EXPECT_CONTAINS(message, "camera 'mandelbulb' has no 'eye'; is 'eyes' a misspelling of it?");
+}
+
 TEST(SceneLoader, ExplicitLayoutTakesRecordsAndContributionsByHand) {
     // The D3D12 ground plane alone, with the table written out and a deliberately odd contribution.
     const std::string text = R"({

@@ -35,7 +35,7 @@ size_t nonFinitePixels(const Image& image) {
 }
 
 TEST(Scene, HitGroupTablesHaveTheSamplesStride) {
-    // Both samples: 32-byte identifier + 56 bytes of procedural arguments, rounded up to 96 (REC-2).
+    // Both samples: 32-byte identifier + 56 bytes of procedural arguments, rounded up to 96 (REC-3).
     for (const std::string& path : {kProceduray, kD3D12}) {
         auto scene = loadScene(path);
         EXPECT_EQ(scene->tables(procedural::Precision::Float).HitGroupTable.StrideInBytes, 96u) << path;

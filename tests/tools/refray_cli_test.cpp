@@ -100,7 +100,9 @@ TEST(RefrayCli, BrokenSceneFileNamesFileLineAndColumn) {
     }
     const CliRun r = run("render " + scene + " -o " + outputPath("never.png"));
     EXPECT_EQ(r.status, 2);
-    EXPECT_NE(r.output.find("broken-scene.json:1:1: the scene has no 'name'"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("broken-scene.json:3:3: the scene has no 'name'; is 'nmae' a misspelling of it?"),
+              std::string::npos)
+        << r.output;
 }
 
 TEST(RefrayCli, SceneOptionsAreCheckedByName) {

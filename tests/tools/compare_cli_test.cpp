@@ -1,0 +1,337 @@
+// `refray compare` as a user runs it: idiff's exit codes, the report, the diff image and
+// the HTML report as a browser (headless Chromium) shows it.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/image.h"
+#include "core/random.h"
+
+namespace {
+
+using refray::Image;
+using refray::vec4;
+
+struct CliRun {
+    int status;
+    std::string output;
+};
+
+CliRun runCommand(const std::string& command) {
+    FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+    CliRun r{-1, {}};
+    if (!pipe) return r;
+    std::array<char, 4096> buffer;
+    while (fgets(buffer.data(), int(buffer.size()), pipe)) r.output += buffer.data();
+    const int status = pclose(pipe);
+    r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+}
+
+CliRun compare(const std::string& arguments) { return runCommand(std::string(REFRAY_BINARY) + " compare " + arguments); }
+
+// A fresh directory per test under the test output directory.
+std::string directory(const std::string& name) {
+    const auto dir = std::filesystem::path(REFRAY_TEST_OUTPUT_DIR) / "compare" / name;
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir.string();
+}
+
+Image noise(uint32_t width, uint32_t height, uint32_t seed) {
+    Image image(width, height);
+    refray::Random random(0, 0, 0, seed);
+    for (vec4& p : image.pixels()) p = vec4(random.nextFloat(), random.nextFloat(), random.nextFloat(), 1.0f);
+    return image;
+}
+
+// Values a PNG holds exactly (k/255), away from 0 and 1.
+Image unorm(uint32_t width, uint32_t height) {
+    Image image(width, height);
+    for (uint32_t y = 0; y < height; ++y)
+        for (uint32_t x = 0; x < width; ++x)
+            image.at(x, y) = vec4(float((x * 11 + y * 3) % 200 + 20) / 255.0f, float((x + y * 7) % 200 + 20) / 255.0f,
+                                  float((x * y) % 200 + 20) / 255.0f, 1.0f);
+    return image;
+}
+
+std::string write(const std::string& path, const Image& image) {
+    refray::writeImage(path, image);
+    return path;
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// --- Headless Chromium -----------------------------------------------------------
+
+std::string findBrowser() {
+    for (const char* name : {"chromium", "chromium-browser"}) {
+        const CliRun r = runCommand(std::string("command -v ") + name);
+        if (r.status == 0 && !r.output.empty()) return r.output.substr(0, r.output.find('\n'));
+    }
+    return {};
+}
+
+// The DOM after the page's scripts ran, or "" with the failure in `error`.
+std::string dumpDom(const std::string& browser, const std::string& htmlPath, const std::string& profile,
+                    std::string& error) {
+    const std::string command = "timeout 120 " + browser + " --headless --disable-gpu --no-sandbox --user-data-dir=" +
+                                profile + " --dump-dom file://" + std::filesystem::absolute(htmlPath).string() +
+                                " 2>/dev/null";
+    FILE* pipe = popen(command.c_str(), "r");
+    if (!pipe) {
+        error = "cannot start " + browser;
+        return {};
+    }
+    std::string dom;
+    std::array<char, 65536> buffer;
+    size_t n;
+    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) dom.append(buffer.data(), n);
+    const int status = pclose(pipe);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) error = "browser exited with " + std::to_string(status);
+    return dom;
+}
+
+#define REQUIRE_BROWSER(browser)                                                                              \
+    const std::string browser = findBrowser();                                                                \
+    if (browser.empty()) {                                                                                    \
+        if (std::getenv("REFRAY_ALLOW_NO_BROWSER")) GTEST_SKIP() << "chromium not installed";                 \
+        FAIL() << "chromium is not installed: run 'bash tools/setup.sh' as root (or set "                     \
+                  "REFRAY_ALLOW_NO_BROWSER=1 to skip the browser checks)";                                    \
+    }
+
+// The <tr class="comparison ..."> rows of a report, in document order.
+std::vector<std::string> comparisonRows(const std::string& dom) {
+    std::vector<std::string> rows;
+    size_t at = dom.find("<tr class=\"comparison");
+    while (at != std::string::npos) {
+        const size_t end = dom.find("</tr>", at);
+        rows.push_back(dom.substr(at, end - at));
+        at = dom.find("<tr class=\"comparison", end);
+    }
+    return rows;
+}
+
+size_t count(const std::string& text, const std::string& part) {
+    size_t n = 0;
+    for (size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++n;
+    return n;
+}
+
+}  // namespace
+
+TEST(CompareCli, IdenticalImagesExitZero) {
+    const std::string dir = directory("identical");
+    const std::string a = write(dir + "/a.exr", noise(32, 24, 1));
+    const CliRun r = compare(a + " " + a);
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "PASS")) << r.output;
+    EXPECT_TRUE(contains(r.output, "FLIP")) << r.output;
+}
+
+TEST(CompareCli, OnePixelOffByHalfExitsTwoAndNamesThePixel) {
+    const std::string dir = directory("one-pixel");
+    Image candidate = noise(16, 12, 2);
+    const std::string ref = write(dir + "/ref.exr", candidate);
+    candidate.at(5, 7).g += 0.5f;
+    const CliRun r = compare(ref + " " + write(dir + "/cand.exr", candidate));
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "at (5, 7) channel G")) << r.output;
+    EXPECT_TRUE(contains(r.output, "FAILURE")) << r.output;
+}
+
+TEST(CompareCli, ErrorUnderFailButOverWarnExitsOne) {
+    const std::string dir = directory("warn");
+    Image candidate = noise(16, 16, 3);
+    const std::string ref = write(dir + "/ref.exr", candidate);
+    candidate.at(1, 2).r += 0.01f;
+    const std::string cand = write(dir + "/cand.exr", candidate);
+    const CliRun r = compare(ref + " " + cand + " --fail 0.1 --warn 0.001");
+    EXPECT_EQ(r.status, 1) << r.output;
+    EXPECT_TRUE(contains(r.output, "WARNING")) << r.output;
+    EXPECT_EQ(compare(ref + " " + cand + " --fail 0.1 --warn 0.02").status, 0);
+    EXPECT_EQ(compare(ref + " " + cand + " --failpercent 1").status, 1);  // 1 of 256 pixels is 0.39 %
+}
+
+TEST(CompareCli, NaNInTheCandidateFailsWhateverTheThresholds) {
+    const std::string dir = directory("nan");
+    Image candidate = noise(8, 8, 4);
+    const std::string ref = write(dir + "/ref.exr", candidate);
+    candidate.at(3, 4).b = std::nanf("");
+    const CliRun r = compare(ref + " " + write(dir + "/cand.exr", candidate) + " --fail 1 --failpercent 100 --warn 1");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "NaN or infinity")) << r.output;
+}
+
+TEST(CompareCli, SizeMismatchExitsThreeNamingBothSizes) {
+    const std::string dir = directory("size");
+    const CliRun r = compare(write(dir + "/ref.png", noise(64, 36, 5)) + " " + write(dir + "/cand.png", noise(32, 18, 5)));
+    EXPECT_EQ(r.status, 3) << r.output;
+    EXPECT_TRUE(contains(r.output, "64x36")) << r.output;
+    EXPECT_TRUE(contains(r.output, "32x18")) << r.output;
+}
+
+TEST(CompareCli, UnreadableFilesExitFourNamingThem) {
+    const std::string dir = directory("missing");
+    const std::string ref = write(dir + "/ref.png", noise(8, 8, 6));
+    CliRun r = compare(ref + " " + dir + "/no-such-candidate.png");
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(contains(r.output, dir + "/no-such-candidate.png")) << r.output;
+    r = compare(dir + "/no-such-reference.png " + ref);
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(contains(r.output, dir + "/no-such-reference.png")) << r.output;
+    std::ofstream(dir + "/garbage.png") << "not an image";
+    r = compare(ref + " " + dir + "/garbage.png");
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(contains(r.output, dir + "/garbage.png")) << r.output;
+}
+
+TEST(CompareCli, ASecondReferenceVariantMatchingPassesAndIsNamed) {
+    const std::string dir = directory("variants");
+    const Image candidate = unorm(20, 20);
+    Image other = candidate;
+    other.at(10, 10).r = 1.0f;
+    write(dir + "/golden.png", other);
+    write(dir + "/golden-gpu.png", candidate);
+    const CliRun r = compare(dir + "/golden.png " + write(dir + "/mine.png", candidate));
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "Matched \"" + dir + "/golden-gpu.png\"")) << r.output;
+
+    // A render saved beside its golden under a variant's name does not match itself.
+    EXPECT_EQ(compare(dir + "/golden.png " + write(dir + "/golden-mine.png", candidate)).status, 0);
+    std::filesystem::remove(dir + "/golden-gpu.png");
+    EXPECT_EQ(compare(dir + "/golden.png " + dir + "/golden-mine.png").status, 2);
+}
+
+TEST(CompareCli, MaskedPixelsDoNotFail) {
+    const std::string dir = directory("mask");
+    Image candidate = unorm(20, 20), mask(20, 20, vec4(0, 0, 0, 1));
+    const std::string ref = write(dir + "/ref.png", candidate);
+    candidate.at(4, 6).r = 1.0f;
+    mask.at(4, 6) = vec4(1.0f);
+    const std::string cand = write(dir + "/cand.png", candidate);
+    const CliRun r = compare(ref + " " + cand + " --mask " + write(dir + "/mask.png", mask));
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "masked pixels   1")) << r.output;
+    EXPECT_EQ(compare(ref + " " + cand).status, 2);
+    EXPECT_EQ(compare(ref + " " + cand + " --mask " + write(dir + "/small-mask.png", Image(4, 4))).status, 3);
+}
+
+TEST(CompareCli, GoldenProfileAcceptsOneUnormStepAndExplicitOptionsWin) {
+    const std::string dir = directory("golden");
+    Image candidate = unorm(20, 20);
+    const std::string ref = write(dir + "/ref.png", candidate);
+    for (vec4& p : candidate.pixels()) p.g += 1.0f / 255.0f;
+    const std::string cand = write(dir + "/cand.png", candidate);
+    EXPECT_EQ(compare(ref + " " + cand).status, 2);
+    const CliRun r = compare("--golden " + ref + " " + cand);
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(compare("--golden --fail 0.001 " + ref + " " + cand).status, 2);
+}
+
+TEST(CompareCli, AlphaIsComparedWithChannelsRgba) {
+    const std::string dir = directory("alpha");
+    // EXR: OpenImageIO (un)premultiplies PNG colour by alpha, EXR keeps the values.
+    Image candidate = unorm(8, 8);
+    const std::string ref = write(dir + "/ref.exr", candidate);
+    candidate.at(2, 2).a = 0.0f;
+    const std::string cand = write(dir + "/cand.exr", candidate);
+    EXPECT_EQ(compare(ref + " " + cand).status, 0);
+    const CliRun r = compare(ref + " " + cand + " --channels rgba");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "channel A")) << r.output;
+}
+
+TEST(CompareCli, WritesADiffHeatMap) {
+    const std::string dir = directory("diff");
+    Image candidate(40, 30, vec4(0.4f, 0.4f, 0.4f, 1.0f));
+    const std::string ref = write(dir + "/ref.png", candidate);
+    candidate.at(30, 10) = vec4(1.0f, 0.0f, 0.0f, 1.0f);
+    const std::string cand = write(dir + "/cand.png", candidate);
+    const CliRun r = compare(ref + " " + cand + " -o " + dir + "/out/diff.png");
+    EXPECT_EQ(r.status, 2) << r.output;
+    const Image diff = refray::readImage(dir + "/out/diff.png");
+    ASSERT_EQ(diff.width(), 40u);
+    ASSERT_EQ(diff.height(), 30u);
+    const auto brightness = [](const vec4& p) { return p.r + p.g + p.b; };
+    EXPECT_GT(brightness(diff.at(30, 10)), brightness(diff.at(3, 25)) + 0.5f);
+    EXPECT_EQ(compare(ref + " " + cand + " --diff /proc/refray-no-diff.png").status, 4);
+}
+
+TEST(CompareCli, HelpDocumentsTheGoldenProfileAndExitCodes) {
+    const CliRun r = runCommand(std::string(REFRAY_BINARY) + " compare --help");
+    EXPECT_EQ(r.status, 0) << r.output;
+    for (const char* part : {"--golden", "--fail", "--failpercent", "--hardfail", "--warnpercent", "--mask", "--html",
+                             "--channels", "magma", "0 pass, 1 warning, 2 failure, 3 size mismatch, 4 file error"})
+        EXPECT_TRUE(contains(r.output, part)) << part << "\n" << r.output;
+}
+
+TEST(CompareCli, HtmlReportShowsFailingRowsFirstInABrowser) {
+    REQUIRE_BROWSER(browser);
+    const std::string dir = directory("html");
+    const Image candidate = unorm(24, 16);
+    Image other = candidate;
+    other.at(3, 3) = vec4(1.0f);
+    write(dir + "/golden.png", candidate);      // matches
+    write(dir + "/golden-zfail.png", other);    // fails
+    const std::string report = dir + "/report.html";
+    const CliRun r = compare(dir + "/golden.png " + write(dir + "/mine.png", candidate) + " --html " + report);
+    ASSERT_EQ(r.status, 0) << r.output;
+
+    std::string error;
+    const std::string dom = dumpDom(browser, report, dir + "/profile", error);
+    ASSERT_TRUE(error.empty()) << error;
+    EXPECT_TRUE(contains(dom, "<span id=\"verdict\" class=\"badge PASS\">PASS</span>")) << dom.substr(0, 2000);
+    const std::vector<std::string> rows = comparisonRows(dom);
+    ASSERT_EQ(rows.size(), 2u) << dom.substr(0, 2000);
+    EXPECT_TRUE(contains(rows[0], "data-verdict=\"FAILURE\"")) << rows[0].substr(0, 300);
+    EXPECT_TRUE(contains(rows[0], "golden-zfail.png"));
+    EXPECT_TRUE(contains(rows[1], "data-verdict=\"PASS\"")) << rows[1].substr(0, 300);
+    EXPECT_TRUE(contains(rows[1], "matched"));
+    for (const std::string& row : rows) {
+        EXPECT_EQ(count(row, "<img "), 3u);
+        EXPECT_EQ(count(row, "src=\"data:image/png;base64,"), 3u);
+        EXPECT_TRUE(contains(row, "max error"));
+        EXPECT_TRUE(contains(row, "FLIP"));
+    }
+    EXPECT_TRUE(contains(rows[0], "at (3, 3)"));
+}
+
+TEST(CompareCli, HtmlHoveringOverTheCandidateShowsTheReference) {
+    REQUIRE_BROWSER(browser);
+    const std::string dir = directory("hover");
+    Image candidate = unorm(16, 16);
+    const std::string ref = write(dir + "/ref.png", candidate);
+    candidate.at(8, 8) = vec4(0.0f, 0.0f, 0.0f, 1.0f);
+    const std::string report = dir + "/report.html";
+    ASSERT_EQ(compare(ref + " " + write(dir + "/cand.png", candidate) + " --html " + report).status, 2);
+
+    // Append a probe that hovers the candidate the way a mouse would and records what it shows.
+    std::ifstream in(report);
+    std::stringstream page;
+    page << in.rdbuf();
+    const std::string probe = R"(<script>
+const row = document.querySelector('tr.comparison');
+const candidate = row.querySelector('img.candidate'), reference = row.querySelector('img.reference');
+const before = candidate.src;
+candidate.dispatchEvent(new MouseEvent('mouseenter'));
+const during = candidate.src === reference.src && row.querySelector('.showing').textContent === 'showing: reference';
+candidate.dispatchEvent(new MouseEvent('mouseleave'));
+const after = candidate.src === before && before !== reference.src;
+document.body.insertAdjacentHTML('beforeend', '<p id="probe">during=' + during + ' after=' + after + '</p>');
+</script>)";
+    std::ofstream(dir + "/probe.html") << page.str() << probe;
+
+    std::string error;
+    const std::string dom = dumpDom(browser, dir + "/probe.html", dir + "/profile", error);
+    ASSERT_TRUE(error.empty()) << error;
+    EXPECT_TRUE(contains(dom, "<p id=\"probe\">during=true after=true</p>")) << dom.substr(dom.size() > 3000 ? dom.size() - 3000 : 0);
+}

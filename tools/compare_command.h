@@ -1,0 +1,61 @@
+// `refray compare REFERENCE CANDIDATE`: a render against a golden image, with idiff's
+// verdicts and exit codes, FLIP, a diff heat map and a self-contained HTML report.
+// docs/compare.md is the user's guide.
+//
+// Wiring into the main program (tools/refray.cpp):
+//     refray::tools::CompareCommandOptions compareOptions;
+//     CLI::App* compare = refray::tools::addCompareCommand(app, compareOptions);
+//     ...after app.parse(argc, argv):
+//     if (*compare) return refray::tools::runCompare(compareOptions);
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "core/compare.h"
+#include "core/image.h"
+
+namespace refray::tools {
+
+// What the command line asks for. After parsing, `thresholds` holds the thresholds to
+// use: --golden's profile with any explicitly given threshold option on top.
+struct CompareCommandOptions {
+    std::string reference, candidate;
+    std::string diffPath, htmlPath, maskPath;
+    std::string channels = "rgb";  // "rgb" or "rgba"
+    std::string diffMode = "flip";  // "flip" or "abs"
+    float diffScale = 1.0f;
+    double pixelsPerDegree = kFlipDefaultPixelsPerDegree;
+    bool golden = false;
+    CompareThresholds thresholds;
+};
+
+// Adds the `compare` subcommand to `app`; app.parse() fills `options`, which must
+// outlive the parse.
+CLI::App* addCompareCommand(CLI::App& app, CompareCommandOptions& options);
+
+// Runs the comparison: the report goes to stdout, errors to stderr. Returns idiff's
+// exit code: 0 pass, 1 warning, 2 failure, 3 size mismatch, 4 file error (a file that
+// cannot be read or written; the message names it). Throws nothing.
+int runCompare(const CompareCommandOptions& options);
+
+// One row of an HTML report: the images shown and the comparison's result. The
+// pointers must stay valid while writeCompareReport runs.
+struct CompareReportRow {
+    std::string referencePath, candidatePath;
+    const Image* reference = nullptr;
+    const Image* candidate = nullptr;
+    const CompareResult* result = nullptr;
+    bool matched = false;  // the row the overall verdict comes from
+};
+
+// Writes one self-contained HTML page (images inline as PNG data URIs): a row per
+// comparison with reference, candidate (hover shows the reference in its place) and
+// diff side by side, then the numbers; failing rows first. Throws refray::Error naming
+// `path` when it cannot be written.
+void writeCompareReport(const std::string& path, CompareVerdict overall, const std::string& summary,
+                        std::vector<CompareReportRow> rows);
+
+}  // namespace refray::tools
