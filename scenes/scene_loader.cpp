@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/hash.h"
 #include "core/strings.h"
+#include "scenes/mesh.h"
 
 namespace refray::scenes {
 
@@ -582,6 +583,33 @@ private:
     GeometryDescFile parseTriangles(ObjectReader& r, const std::string& prefix) {
         GeometryDescFile g;
         g.type = dxr::GeometryType::Triangles;
+        if (const Value* mesh = r.optional("mesh")) {
+            // An OBJ file, relative to the scene file: its positions and triangulated faces become two buffers.
+            if (r.optional("vertices") || r.optional("indices"))
+                mesh->fail("a triangle geometry takes 'mesh' or 'vertices' (and 'indices'), not both");
+            const std::filesystem::path path = scene_.file.parent_path() / mesh->asString();
+            TriangleMesh data;
+            try {
+                data = loadObjMesh(path);
+            } catch (const Error& e) {
+                mesh->fail(e.what());
+            }
+            BufferDesc positions;
+            positions.name = prefix + "/mesh positions";
+            positions.stride = 12;
+            positions.bytes.resize(data.positions.size() * sizeof(vec3));
+            std::memcpy(positions.bytes.data(), data.positions.data(), positions.bytes.size());
+            g.vertexCount = uint32_t(data.positions.size());
+            g.vertexBuffer = addBuffer(std::move(positions), *mesh);
+            BufferDesc indices;
+            indices.name = prefix + "/mesh indices";
+            indices.bytes.resize(data.indices.size() * 4);
+            std::memcpy(indices.bytes.data(), data.indices.data(), indices.bytes.size());
+            g.indexCount = uint32_t(data.indices.size());
+            g.indexFormat = dxr::Format::R32_UINT;
+            g.indexBuffer = int32_t(addBuffer(std::move(indices), *mesh));
+            return g;
+        }
         const Value& vertices = r.required("vertices");
         if (vertices.isArray()) {
             BufferDesc b;

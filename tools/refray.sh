@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # One command from a fresh Debian 12 machine to a render: installs refray's packages
 # (tools/setup.sh), configures and builds the release preset when needed, then runs
-# `refray` with the given arguments, e.g.  bash tools/refray.sh render -o refray.png
+# `refray` with the given arguments, e.g.
+#   bash tools/refray.sh render scenes/proceduray-mandel-julia-pac.json -o proceduray.png
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

@@ -7,7 +7,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libembree-dev libopenimageio-dev openimageio-tools libglm-dev libtbb-dev
   googletest libgtest-dev libgmock-dev libbenchmark-dev
-  libcli11-dev
+  libcli11-dev libtinyobjloader-dev
   chromium  # the compare tool's HTML report is checked in headless Chromium
 )
 
