@@ -125,18 +125,7 @@ RenderResult BuiltinScene::render(const RenderSettings& settings) {
     desc.Width = settings.width;
     desc.Height = settings.height;
     desc.Depth = 1;
-    DispatchOptions options;
-    options.threads = settings.threads;
-    options.order = settings.order;
-    options.adversarialSeed = settings.adversarialSeed;
-    options.onError = settings.onError;
-    std::unique_ptr<Progress> progress;
-    if (settings.progress) {
-        progress = std::make_unique<Progress>("render", uint64_t(settings.width) * settings.height, settings.progress);
-        options.progress = progress.get();
-    }
-    result.dispatch = device_.dispatchRays(desc, pipeline_, &globals, options);
-    if (progress) progress->finish();
+    result.dispatch = dispatchWithSettings(device_, desc, pipeline_, &globals, settings);
     return result;
 }
 

@@ -3,11 +3,13 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 
 #include "core/image.h"
 #include "core/progress.h"
+#include "emulator/device.h"
 #include "emulator/dispatcher.h"
 #include "procedural/precision.h"
 
@@ -30,6 +32,25 @@ struct RenderSettings {
     // unchanged). 1 is the GPU's image.
     uint32_t spp = 1;
 };
+
+// Runs DispatchRays for a width x height dispatch with the settings' threads, order, error mode and progress.
+inline dxr::DispatchResult dispatchWithSettings(dxr::Device& device, const dxr::DispatchRaysDesc& desc,
+                                                const dxr::StateObjectPtr& pipeline, const dxr::GlobalRootArguments* globals,
+                                                const RenderSettings& settings) {
+    dxr::DispatchOptions options;
+    options.threads = settings.threads;
+    options.order = settings.order;
+    options.adversarialSeed = settings.adversarialSeed;
+    options.onError = settings.onError;
+    std::unique_ptr<Progress> progress;
+    if (settings.progress) {
+        progress = std::make_unique<Progress>("render", uint64_t(desc.Width) * desc.Height * desc.Depth, settings.progress);
+        options.progress = progress.get();
+    }
+    dxr::DispatchResult result = device.dispatchRays(desc, pipeline, globals, options);
+    if (progress) progress->finish();
+    return result;
+}
 
 struct RenderResult {
     Image image;  // the render target as the shaders wrote it (float RGBA)

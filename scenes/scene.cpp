@@ -260,19 +260,8 @@ RenderResult Scene::render(const RenderSettings& settings) {
     desc.Width = width;
     desc.Height = height;
     desc.Depth = 1;
-    DispatchOptions options;
-    options.threads = settings.threads;
-    options.order = settings.order;
-    options.adversarialSeed = settings.adversarialSeed;
-    options.onError = settings.onError;
-    std::unique_ptr<Progress> progress;
-    if (settings.progress) {
-        progress = std::make_unique<Progress>("render", uint64_t(width) * height, settings.progress);
-        options.progress = progress.get();
-    }
     RenderResult result;
-    result.dispatch = device_.dispatchRays(desc, pipeline.stateObject, &globals, options);
-    if (progress) progress->finish();
+    result.dispatch = dispatchWithSettings(device_, desc, pipeline.stateObject, &globals, settings);
 
     // k x k samples per output pixel, averaged in float in a fixed order (deterministic).
     if (k == 1) {

@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "procedural/proceduray/proceduray_shaders.h"
 #include "scenes/scene_loader.h"
+#include "tests/scenes/scene_test_support.h"
 
 namespace refray::scenes {
 namespace {
@@ -16,33 +17,13 @@ namespace {
 const std::string kProceduray = std::string(REFRAY_SOURCE_DIR) + "/scenes/proceduray-mandel-julia-pac.json";
 const std::string kD3D12 = std::string(REFRAY_SOURCE_DIR) + "/scenes/d3d12-procedural-geometry.json";
 
-std::string readText(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using testing::loadError;
+using testing::readText;
 
 // The Proceduray file with `from` replaced by `to` (which must occur exactly once).
 std::string edited(const std::string& from, const std::string& to, const std::string& path = kProceduray) {
-    std::string text = readText(path);
-    const size_t at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    EXPECT_EQ(text.find(from, at + 1), std::string::npos) << "not unique: " << from;
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-    return text;
+    return testing::edited(readText(path), from, to);
 }
-
-// The error message of loading `text`, or "" if it loads.
-std::string loadError(const std::string& text) {
-    try {
-        parseScene(text, "broken.json");
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
-}
-
-#define EXPECT_CONTAINS(haystack, needle) \
-    EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << "message: " << (haystack)
 
 TEST(SceneLoader, ProceduraySceneFollowsTheFactSheet) {
     const SceneDesc s = loadSceneFile(kProceduray);

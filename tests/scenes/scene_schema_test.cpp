@@ -18,6 +18,7 @@
 #include "core/json.h"
 #include "scenes/scene.h"
 #include "scenes/scene_loader.h"
+#include "tests/scenes/scene_test_support.h"
 
 namespace refray::scenes {
 namespace {
@@ -370,11 +371,7 @@ private:
 
 // ---- Helpers -----------------------------------------------------------------------------------------------------
 
-std::string readText(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    EXPECT_TRUE(in.good()) << "cannot read " << path;
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using testing::readText;
 
 const SchemaValidator& sceneSchema() {
     static const SchemaValidator validator(json::parseFile(kSchema));
@@ -403,27 +400,8 @@ std::string documentedExample() {
     return doc.substr(begin + fence.size(), end - begin - fence.size() + 1);
 }
 
-// `text` with `from` replaced by `to` (which must occur exactly once).
-std::string edited(std::string text, const std::string& from, const std::string& to) {
-    const size_t at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    EXPECT_EQ(text.find(from, at + 1), std::string::npos) << "not unique: " << from;
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-    return text;
-}
-
-// The loader's error for `text`, or "" if it loads.
-std::string loadError(const std::string& text) {
-    try {
-        parseScene(text, "broken.json");
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
-}
-
-#define EXPECT_CONTAINS(haystack, needle) \
-    EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << "message: " << (haystack)
+using testing::edited;
+using testing::loadError;
 
 // ---- The validator -------------------------------------------------------------------------------------------------
 

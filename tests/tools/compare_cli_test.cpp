@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "tests/tools/cli_run.h"
 #include "core/random.h"
 
 namespace {
@@ -20,21 +21,8 @@ namespace {
 using refray::Image;
 using refray::vec4;
 
-struct CliRun {
-    int status;
-    std::string output;
-};
-
-CliRun runCommand(const std::string& command) {
-    FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-    CliRun r{-1, {}};
-    if (!pipe) return r;
-    std::array<char, 4096> buffer;
-    while (fgets(buffer.data(), int(buffer.size()), pipe)) r.output += buffer.data();
-    const int status = pclose(pipe);
-    r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-}
+using refray::testing::CliRun;
+using refray::testing::runCommand;
 
 CliRun compare(const std::string& arguments) { return runCommand(std::string(REFRAY_BINARY) + " compare " + arguments); }
 

@@ -7,25 +7,13 @@
 #include <string>
 
 #include "core/image.h"
+#include "tests/tools/cli_run.h"
 
 namespace {
 
-struct CliRun {
-    int status;
-    std::string output;
-};
+using refray::testing::CliRun;
 
-CliRun run(const std::string& arguments) {
-    const std::string command = std::string(REFRAY_BINARY) + " " + arguments + " 2>&1";
-    FILE* pipe = popen(command.c_str(), "r");
-    CliRun r{-1, {}};
-    if (!pipe) return r;
-    std::array<char, 4096> buffer;
-    while (fgets(buffer.data(), int(buffer.size()), pipe)) r.output += buffer.data();
-    const int status = pclose(pipe);
-    r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return r;
-}
+CliRun run(const std::string& arguments) { return refray::testing::runCommand(std::string(REFRAY_BINARY) + " " + arguments); }
 
 std::string outputPath(const std::string& name) {
     std::filesystem::create_directories(REFRAY_TEST_OUTPUT_DIR);
