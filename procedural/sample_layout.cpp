@@ -42,6 +42,29 @@ uint32_t loadDword(const uint8_t* data, size_t sizeInBytes, uint32_t offset) {
 }
 }  // namespace
 
+Float4x4 rowVectorForm(const Matrix3x4& columnForm) {
+    Float4x4 r;
+    for (size_t i = 0; i < 3; ++i)
+        for (size_t j = 0; j < 3; ++j) r.m[i][j] = columnForm.m[j][i];
+    r.m[3] = {columnForm.m[0][3], columnForm.m[1][3], columnForm.m[2][3], 1.0f};
+    return r;
+}
+
+DMat4 multiply(const DMat4& a, const DMat4& b) {
+    DMat4 r{};
+    for (size_t i = 0; i < 4; ++i)
+        for (size_t j = 0; j < 4; ++j)
+            for (size_t k = 0; k < 4; ++k) r[i][j] += a[i][k] * b[k][j];
+    return r;
+}
+
+Float4x4 toFloat4x4(const DMat4& m) {
+    Float4x4 r;
+    for (size_t i = 0; i < 4; ++i)
+        for (size_t j = 0; j < 4; ++j) r.m[i][j] = float(m[i][j]);
+    return r;
+}
+
 uvec3 unpack3x16BitIndices(uint32_t offsetBytes, uvec2 four16BitIndices) {
     const uint32_t dwordAlignedOffset = offsetBytes & ~3u;
     uvec3 result;

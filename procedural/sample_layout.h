@@ -53,6 +53,17 @@ dxr::RootSignatureDesc sampleTriangleLocalRootSignatureDesc(std::string name);
 // Local, procedural: PrimitiveConstantBuffer at b1, then PrimitiveInstanceConstantBuffer at b2.
 dxr::RootSignatureDesc sampleProceduralLocalRootSignatureDesc(std::string name);
 
+// ---- Host side: the matrices the samples' hosts compute for their shaders ------------------------------
+
+// A DXR 3x4 instance transform (column vectors, translation in column 3) in the row-vector float4x4 form
+// HLSL /Zpr shaders read (translation in row 3).
+Float4x4 rowVectorForm(const Matrix3x4& columnForm);
+
+// Host matrix math in double, row-vector form [row][column] (p' = p · M), rounded to float once at the end.
+using DMat4 = std::array<std::array<double, 4>, 4>;
+DMat4 multiply(const DMat4& a, const DMat4& b);
+Float4x4 toFloat4x4(const DMat4& m);
+
 // mul(v, M) for a row vector, summed in row order (HLSL mul with /Zpr matrices).
 template <typename T>
 glm::vec<4, T> mul(const glm::vec<4, T>& v, const Float4x4& M) {

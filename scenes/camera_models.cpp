@@ -9,15 +9,7 @@ namespace refray::scenes {
 namespace {
 
 using glm::dvec3;
-using DMat4 = std::array<std::array<double, 4>, 4>;  // [row][column], row vectors: p' = p · M
-
-DMat4 multiply(const DMat4& a, const DMat4& b) {
-    DMat4 r{};
-    for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j)
-            for (int k = 0; k < 4; ++k) r[i][j] += a[i][k] * b[k][j];
-    return r;
-}
+using procedural::DMat4;
 
 // General 4x4 inverse by Gauss-Jordan elimination with partial pivoting.
 DMat4 inverse(DMat4 m) {
@@ -93,11 +85,7 @@ procedural::Float4x4 projectionToWorld(const CameraDesc& camera, uint32_t width,
         const double range = f / (f - n);
         projection = {{{w, 0, 0, 0}, {0, Y, 0, 0}, {0, 0, range, 1}, {0, 0, -range * n, 0}}};
     }
-    const DMat4 result = inverse(multiply(view, projection));
-    procedural::Float4x4 out;
-    for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j) out.m[i][j] = float(result[i][j]);
-    return out;
+    return procedural::toFloat4x4(inverse(procedural::multiply(view, projection)));
 }
 
 }  // namespace refray::scenes

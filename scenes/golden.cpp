@@ -123,7 +123,7 @@ GoldenSet updateGoldens(const GoldenUpdateOptions& options) {
             e.width = options.width;
             e.height = options.height;
             e.image = e.name + ".exr";
-            e.mask = e.name + ".order-mask.png";
+            e.mask = orderMaskPath(e.image);
             e.orders = options.orders;
             e.refrayCommit = options.refrayCommit;
             const OrderCheckResult check = checkTraversalOrder(scene, goldenSettings(e, options.threads), options.orders);

@@ -1,8 +1,14 @@
 #include "scenes/order_check.h"
 
 #include <cstring>
+#include <filesystem>
 
 namespace refray::scenes {
+
+std::string orderMaskPath(const std::string& imagePath) {
+    const std::filesystem::path p(imagePath);
+    return (p.parent_path() / (p.stem().string() + ".order-mask.png")).string();
+}
 
 OrderCheckResult checkTraversalOrder(Scene& scene, const RenderSettings& settings, uint32_t adversarialOrders) {
     OrderCheckResult result;

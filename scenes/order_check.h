@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "core/image.h"
 #include "scenes/scene.h"
@@ -17,6 +18,9 @@ struct OrderCheckResult {
     uint64_t orderDependentPixels = 0;
     uint32_t orders = 0;  // adversarial renders made (seeds 1..orders)
 };
+
+// Where the mask of the image at `imagePath` goes: "out.png" -> "out.order-mask.png" beside it.
+std::string orderMaskPath(const std::string& imagePath);
 
 // `settings.order` and `settings.adversarialSeed` are ignored: the first render is ordered, then seeds 1..n.
 // `settings.progress`, when set, sees each render in turn.

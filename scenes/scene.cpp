@@ -10,36 +10,14 @@
 namespace refray::scenes {
 
 using namespace refray::dxr;
+using procedural::DMat4;
+using procedural::multiply;
+using procedural::rowVectorForm;
+using procedural::toFloat4x4;
 using procedural::Float4x4;
 using procedural::Precision;
 
 namespace {
-
-// A DXR 3x4 (column-vector) transform in the row-vector float4x4 form HLSL /Zpr shaders read.
-Float4x4 rowVectorForm(const Matrix3x4& m) {
-    Float4x4 r;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) r.m[size_t(i)][size_t(j)] = m.m[size_t(j)][size_t(i)];
-    r.m[3] = {m.m[0][3], m.m[1][3], m.m[2][3], 1.0f};
-    return r;
-}
-
-using DMat4 = std::array<std::array<double, 4>, 4>;
-
-DMat4 multiply(const DMat4& a, const DMat4& b) {
-    DMat4 r{};
-    for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j)
-            for (int k = 0; k < 4; ++k) r[size_t(i)][size_t(j)] += a[size_t(i)][size_t(k)] * b[size_t(k)][size_t(j)];
-    return r;
-}
-
-Float4x4 toFloat(const DMat4& m) {
-    Float4x4 r;
-    for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j) r.m[size_t(i)][size_t(j)] = float(m[size_t(i)][size_t(j)]);
-    return r;
-}
 
 // S·R·Tr of an element of a primitiveTransforms buffer and its inverse Tr⁻¹·Rᵀ·S⁻¹, in double.
 std::pair<Float4x4, Float4x4> primitiveTransform(const PrimitiveTransformDesc& p, double time) {
@@ -55,7 +33,7 @@ std::pair<Float4x4, Float4x4> primitiveTransform(const PrimitiveTransformDesc& p
         T[3][size_t(k)] = p.centre[k];
         Ti[3][size_t(k)] = -double(p.centre[k]);
     }
-    return {toFloat(multiply(multiply(S, R), T)), toFloat(multiply(multiply(Ti, Rt), Si))};
+    return {toFloat4x4(multiply(multiply(S, R), T)), toFloat4x4(multiply(multiply(Ti, Rt), Si))};
 }
 
 uint32_t sampleGridSize(uint32_t spp) {
@@ -174,12 +152,11 @@ Scene::Pipeline& Scene::pipelineFor(Precision precision) {
     return pipelines_.emplace(precision, std::move(p)).first->second;
 }
 
-GpuVirtualAddress Scene::generateBuffer(const BufferDesc& b, const RenderSettings& settings, float time, uint32_t width,
+GpuVirtualAddress Scene::generateBuffer(const BufferDesc& b, const CameraDesc& camera, float time, uint32_t width,
                                         uint32_t height) {
     GpuMemory& memory = device_.memory();
     switch (b.kind) {
         case BufferDesc::Kind::SceneConstants: {
-            const CameraDesc& camera = desc_.camera(settings.camera);
             SceneConstantsInput in;
             in.projectionToWorld = projectionToWorld(camera, width, height);
             in.cameraPosition = vec4(vec3(camera.eye), 1.0f);
@@ -232,7 +209,7 @@ RenderResult Scene::render(const RenderSettings& settings) {
     for (size_t i = 0; i < desc_.buffers.size(); ++i)
         frameAddresses[i] = desc_.buffers[i].kind == BufferDesc::Kind::Data
                                 ? bufferAddresses_[i]
-                                : generateBuffer(desc_.buffers[i], settings, time, width, height);
+                                : generateBuffer(desc_.buffers[i], camera, time, width, height);
 
     GlobalRootArguments globals(globalSignature_);
     uint32_t slot = 0;

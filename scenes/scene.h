@@ -32,8 +32,8 @@ private:
         dxr::DispatchRaysDesc tables;
     };
     Pipeline& pipelineFor(procedural::Precision precision);
-    dxr::GpuVirtualAddress generateBuffer(const BufferDesc& buffer, const RenderSettings& settings, float time,
-                                          uint32_t width, uint32_t height);
+    dxr::GpuVirtualAddress generateBuffer(const BufferDesc& buffer, const CameraDesc& camera, float time, uint32_t width,
+                                          uint32_t height);
 
     SceneDesc desc_;
     dxr::Device device_;

@@ -398,7 +398,8 @@ private:
                 if (o.name == pi.name) p.fail("root signature " + inQuotes(desc.name) + " has two parameters " + inQuotes(pi.name));
             const Value& kindValue = pr.required("kind");
             const uint32_t kind = resolveName(kindValue, {"constants", "cbv", "srv", "uav", "table"}, "parameter kind");
-            const uint32_t space = pr.optional("space") ? pr.optional("space")->asUint32() : 0;
+            const Value* spaceValue = pr.optional("space");
+            const uint32_t space = spaceValue ? spaceValue->asUint32() : 0;
             const std::string what = "parameter " + inQuotes(pi.name);
             if (kind == 4) {
                 std::vector<dxr::DescriptorRange> ranges;
@@ -446,7 +447,6 @@ private:
                     expectRegisterClass(reg, cls, 'u', what);
                     desc.parameters.push_back(dxr::RootParameter::uav(n, space));
                 }
-                desc.parameters.back().registerSpace = space;
             }
             pr.finish();
             info.parameters.push_back(pi);

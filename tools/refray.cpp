@@ -76,11 +76,6 @@ struct RenderOptions {
     uint32_t orderCheck = 0;
 };
 
-// "out.png" -> "out.order-mask.png".
-std::string maskPath(const std::string& output) {
-    std::filesystem::path p(output);
-    return (p.parent_path() / (p.stem().string() + ".order-mask.png")).string();
-}
 
 void writeOutput(const std::string& path, const Image& image) {
     const auto parent = std::filesystem::path(path).parent_path();
@@ -122,7 +117,7 @@ int runRender(const RenderOptions& o) {
         if (o.orderCheck > 0) {
             scenes::OrderCheckResult check = scenes::checkTraversalOrder(*scene, settings, o.orderCheck);
             result = std::move(check.ordered);
-            const std::string mask = maskPath(o.output);
+            const std::string mask = scenes::orderMaskPath(o.output);
             check.mask.metadata["refray_commit"] = tools::kCommit;
             writeOutput(mask, check.mask);
             std::printf("order check: %llu of %u pixels depend on the traversal order (ordered vs %u adversarial "

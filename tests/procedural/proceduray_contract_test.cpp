@@ -31,13 +31,7 @@ using namespace refray::dxr;
 // ---- The rig --------------------------------------------------------------------------------------
 
 // The instance buffer's matrices in row-vector form (§1.7): local = world · inverse(M).
-Float4x4 rowVectorForm(const Matrix3x4& columnForm) {
-    Float4x4 r;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) r.m[i][j] = columnForm.m[j][i];
-    r.m[3] = {columnForm.m[0][3], columnForm.m[1][3], columnForm.m[2][3], 1.0f};
-    return r;
-}
+using procedural::rowVectorForm;
 
 // One procedural instance of the reference scene (§1.2, §1.8).
 struct ProceduralCase {

@@ -161,13 +161,7 @@ TEST(ProcedurayShaders, FresnelAndCameraRay) {
 // ---- A tiny scene ---------------------------------------------------------------------------------
 
 // The instance buffer's matrices in row-vector form (§1.7): local = world · inverse(M).
-Float4x4 rowVectorForm(const Matrix3x4& columnForm) {
-    Float4x4 r;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) r.m[i][j] = columnForm.m[j][i];
-    r.m[3] = {columnForm.m[0][3], columnForm.m[1][3], columnForm.m[2][3], 1.0f};
-    return r;
-}
+using procedural::rowVectorForm;
 
 // The material table of §1.8.
 constexpr PrimitiveConstantBuffer kPacmanMaterial{{1, 1, 0, 1}, 0.3f, 0.3f, 0.7f, 50.0f, 1.0f, vec3(0.0f)};
