@@ -663,4 +663,104 @@ void ObjectReader::finish() const {
     }
 }
 
+// ---- JSON Patch ------------------------------------------------------------------------------------
+
+namespace {
+
+// RFC 6901: "/a/b~1c" -> {"a", "b/c"}.
+std::vector<std::string> pointerTokens(const Value& path) {
+    const std::string& text = path.asString();
+    if (text.empty()) path.fail("a patch path must name a member or element, not the whole document");
+    if (text[0] != '/') path.fail("a JSON Pointer starts with '/', got '" + text + "'");
+    std::vector<std::string> tokens;
+    std::string token;
+    for (size_t i = 1; i <= text.size(); ++i) {
+        if (i == text.size() || text[i] == '/') {
+            tokens.push_back(token);
+            token.clear();
+        } else if (text[i] == '~') {
+            if (i + 1 < text.size() && (text[i + 1] == '0' || text[i + 1] == '1')) {
+                token += text[i + 1] == '0' ? '~' : '/';
+                ++i;
+            } else {
+                path.fail("'~' in a JSON Pointer must be followed by 0 or 1: '" + text + "'");
+            }
+        } else {
+            token += text[i];
+        }
+    }
+    return tokens;
+}
+
+// An array index token: digits without leading zeros, below `limit` (inclusive when `allowEnd`).
+size_t arrayIndex(const Value& path, const std::string& token, size_t size, bool allowEnd) {
+    const bool digits = !token.empty() && token.size() <= 9 &&
+                        std::all_of(token.begin(), token.end(), [](char c) { return c >= '0' && c <= '9'; }) &&
+                        (token.size() == 1 || token[0] != '0');
+    if (!digits) path.fail("'" + token + "' in path '" + path.asString() + "' is not an array index");
+    const size_t index = std::stoul(token);
+    if (index > size || (index == size && !allowEnd))
+        path.fail("path '" + path.asString() + "': index " + token + " is past the end of an array of " +
+                  std::to_string(size) + " elements");
+    return index;
+}
+
+}  // namespace
+
+void applyPatch(Value& document, const Value& patch) {
+    for (const Value& operation : patch.asArray()) {
+        ObjectReader reader(operation, "a patch operation");
+        const Value& opValue = reader.required("op");
+        const std::string& op = opValue.asString();
+        if (op != "replace" && op != "add" && op != "remove")
+            opValue.fail("unknown patch op '" + op + "'" + didYouMean(op, {"replace", "add", "remove"}) +
+                         "; expected replace, add or remove");
+        const Value& path = reader.required("path");
+        const Value* value = op == "remove" ? nullptr : &reader.required("value");
+        reader.finish();
+
+        const std::vector<std::string> tokens = pointerTokens(path);
+        Value* parent = &document;
+        for (size_t i = 0; i + 1 < tokens.size(); ++i) {
+            if (parent->kind_ == Value::Kind::Object) {
+                auto it = std::find_if(parent->object_.begin(), parent->object_.end(),
+                                       [&](const Member& m) { return m.key == tokens[i]; });
+                if (it == parent->object_.end())
+                    path.fail("path '" + path.asString() + "': no member '" + tokens[i] + "'");
+                parent = &it->value;
+            } else if (parent->kind_ == Value::Kind::Array) {
+                parent = &parent->array_[arrayIndex(path, tokens[i], parent->array_.size(), false)];
+            } else {
+                path.fail("path '" + path.asString() + "': '" + tokens[i] + "' is inside " +
+                          std::string(parent->kindName()));
+            }
+        }
+        const std::string& last = tokens.back();
+        if (parent->kind_ == Value::Kind::Object) {
+            auto it = std::find_if(parent->object_.begin(), parent->object_.end(), [&](const Member& m) { return m.key == last; });
+            if (op != "add" && it == parent->object_.end())
+                path.fail("path '" + path.asString() + "': no member '" + last + "' to " + op);
+            if (op == "remove") {
+                parent->object_.erase(it);
+            } else if (it != parent->object_.end()) {
+                it->value = *value;
+            } else {
+                parent->object_.push_back(Member{last, path.location(), *value});
+            }
+        } else if (parent->kind_ == Value::Kind::Array) {
+            std::vector<Value>& array = parent->array_;
+            if (op == "add") {
+                const size_t at = last == "-" ? array.size() : arrayIndex(path, last, array.size(), true);
+                array.insert(array.begin() + std::ptrdiff_t(at), *value);
+            } else {
+                const size_t at = arrayIndex(path, last, array.size(), false);
+                if (op == "remove") array.erase(array.begin() + std::ptrdiff_t(at));
+                else array[at] = *value;
+            }
+        } else {
+            path.fail("path '" + path.asString() + "': '" + last + "' is inside " + std::string(parent->kindName()));
+        }
+    }
+}
+
 }  // namespace refray::json

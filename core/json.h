@@ -73,6 +73,7 @@ public:
 
 private:
     friend class detail::Parser;
+    friend void applyPatch(Value& document, const Value& patch);
 
     [[noreturn]] void failKind(std::string_view expected) const;
 
@@ -102,6 +103,12 @@ Value parse(std::string_view text, std::string file);
 
 // Reads the file (error "cannot read FILE: reason") and parses it, naming it path.string().
 Value parseFile(const std::filesystem::path& path);
+
+// Applies a JSON Patch (RFC 6902) of "replace", "add" and "remove" operations, with RFC 6901 JSON Pointer
+// paths ("/instances/4/mask"; "-" appends to an array), to `document`, in order. Values taken from the patch keep
+// the patch's locations, so later errors point at the line that introduced them. A bad operation throws
+// refray::Error at its location naming the path and what is there.
+void applyPatch(Value& document, const Value& patch);
 
 // Reads an object member by member and reports keys nobody asked for. Keeps a pointer
 // to `value`, which must outlive the reader.

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
 
 namespace refray {
 
@@ -36,6 +39,61 @@ std::optional<std::string> closestMatch(std::string_view name, const std::vector
 std::string didYouMean(std::string_view name, const std::vector<std::string>& candidates) {
     auto match = closestMatch(name, candidates);
     return match ? " (did you mean '" + *match + "'?)" : std::string();
+}
+
+std::string joined(const std::vector<std::string>& names, std::string_view separator) {
+    std::string out;
+    for (size_t i = 0; i < names.size(); ++i) {
+        if (i) out += separator;
+        out += names[i];
+    }
+    return out;
+}
+
+std::string jsonQuote(std::string_view text) {
+    std::string out = "\"";
+    for (const char c : text) {
+        switch (c) {
+            case '"': out += "\\\""; break;
+            case '\\': out += "\\\\"; break;
+            case '\n': out += "\\n"; break;
+            case '\t': out += "\\t"; break;
+            case '\r': out += "\\r"; break;
+            default:
+                if ((unsigned char)c < 0x20) {
+                    char buffer[8];
+                    std::snprintf(buffer, sizeof buffer, "\\u%04x", unsigned((unsigned char)c));
+                    out += buffer;
+                } else {
+                    out += c;
+                }
+        }
+    }
+    out += '"';
+    return out;
+}
+
+std::string htmlEscape(std::string_view text) {
+    std::string out;
+    for (const char c : text) {
+        switch (c) {
+            case '&': out += "&amp;"; break;
+            case '<': out += "&lt;"; break;
+            case '>': out += "&gt;"; break;
+            case '"': out += "&quot;"; break;
+            case '\'': out += "&#39;"; break;
+            default: out += c;
+        }
+    }
+    return out;
+}
+
+std::string shortestFloat(float value) {
+    if (std::isnan(value)) return "nan";
+    if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+    char text[32];
+    const auto end = std::to_chars(text, text + sizeof text, value);
+    return std::string(text, end.ptr);
 }
 
 }  // namespace refray

@@ -17,4 +17,14 @@ std::optional<std::string> closestMatch(std::string_view name, const std::vector
 // " (did you mean 'X'?)" or "" — ready to append to a message.
 std::string didYouMean(std::string_view name, const std::vector<std::string>& candidates);
 
+// "a, b, c".
+std::string joined(const std::vector<std::string>& names, std::string_view separator = ", ");
+
+// `text` as a JSON string literal, quotes included (control characters escaped).
+std::string jsonQuote(std::string_view text);
+// `text` with &, <, >, " and ' escaped for HTML.
+std::string htmlEscape(std::string_view text);
+// A float as the shortest decimal text that reads back as the same float ("0.1", "1e+30", "nan").
+std::string shortestFloat(float value);
+
 }  // namespace refray

@@ -87,6 +87,32 @@ void raise(ThreadState& ts, const Site& site, const Diagnostic& d) {
 
 void warn(ThreadState& ts, const Site& site, const Diagnostic& d) { ts.log.add(locate(ts, d, site), ts.linearIndex); }
 
+// ---- Trace events (emulator/trace.h): built only when an observer is installed.
+
+TraceObserver* observer(const ThreadState& ts) { return ts.dispatch->options.observer; }
+
+TraceEvent event(const ThreadState& ts, TraceEvent::Kind kind, uint32_t depth) {
+    TraceEvent e;
+    e.kind = kind;
+    e.launchIndex = ts.launchIndex;
+    e.depth = depth;
+    return e;
+}
+
+void setHit(TraceEvent& e, const BuiltInstance& inst, uint32_t instanceIndex, uint32_t geometryIndex,
+            uint32_t primitiveIndex) {
+    e.instanceIndex = instanceIndex;
+    e.instanceID = inst.desc.InstanceID;
+    e.geometryIndex = geometryIndex;
+    e.primitiveIndex = primitiveIndex;
+}
+
+void emitSkipped(const ThreadState& ts, const RayState& rs, std::string_view why) {
+    TraceEvent e = event(ts, TraceEvent::Kind::Skipped, rs.depth);
+    e.note = why;
+    observer(ts)->onEvent(e);
+}
+
 const char* tableName(ProgramEntry::Kind kind) {
     switch (kind) {
         case ProgramEntry::Kind::HitGroup: return "hit-group table";
@@ -119,9 +145,9 @@ void addHitValues(DiagnosticBuilder& b, const HitLookupContext* h) {
 
 // Resolves the record at `index` of `table` (IDX-9..14, REC-7..11). Returns false when
 // the lookup failed in OnError::Continue mode (the caller treats it as a NULL record).
-bool lookupRecord(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
-                  const GpuVirtualAddressRangeAndStride& table, uint64_t index, RecordView& out,
-                  const HitLookupContext* hit = nullptr) {
+bool lookupRecordChecked(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
+                         const GpuVirtualAddressRangeAndStride& table, uint64_t index, RecordView& out,
+                         const HitLookupContext* hit) {
     const DispatchState& ds = *ts.dispatch;
     const std::string_view name = tableName(kind);
     out = RecordView{};
@@ -142,7 +168,10 @@ bool lookupRecord(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
         b.value("index", index)
             .value("stride", table.StrideInBytes)
             .value("record offset + 32", offset + kShaderIdentifierSizeInBytes, "SizeInBytes " + std::to_string(table.SizeInBytes))
-            .value("records in table", table.StrideInBytes ? table.SizeInBytes / table.StrideInBytes : 1);
+            .value("records in table", table.StrideInBytes == 0 ? 1
+                                       : table.SizeInBytes < kShaderIdentifierSizeInBytes
+                                           ? 0
+                                           : (table.SizeInBytes - kShaderIdentifierSizeInBytes) / table.StrideInBytes + 1);
         raise(ts, site, b);
         return false;
     }
@@ -220,6 +249,34 @@ bool lookupRecord(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
     return true;
 }
 
+bool lookupRecord(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
+                  const GpuVirtualAddressRangeAndStride& table, uint64_t index, RecordView& out,
+                  const HitLookupContext* hit = nullptr) {
+    if (!observer(ts)) return lookupRecordChecked(ts, site, kind, table, index, out, hit);
+    TraceEvent e = event(ts, TraceEvent::Kind::RecordLookup,                        site.depth + (kind == ProgramEntry::Kind::HitGroup || kind == ProgramEntry::Kind::Miss ? 1 : 0));
+    e.table = tableName(kind);
+    e.recordIndex = index;
+    e.recordAddress = table.StartAddress + table.StrideInBytes * index;
+    e.stride = table.StrideInBytes;
+    if (hit && hit->terms) {
+        e.hasTerms = true;
+        e.terms = *hit->terms;
+    }
+    if (hit && hit->hit) setHit(e, *hit->hit->instance, hit->hit->instanceIndex, hit->hit->geometryIndex, hit->hit->primitiveIndex);
+    bool ok = false;
+    try {
+        ok = lookupRecordChecked(ts, site, kind, table, index, out, hit);
+    } catch (...) {
+        e.note = "invalid";
+        observer(ts)->onEvent(e);
+        throw;
+    }
+    e.note = !ok ? "invalid" : out.entry ? "" : "NULL";
+    if (out.entry) e.exportName = out.entry->name;
+    observer(ts)->onEvent(e);
+    return ok;
+}
+
 // PIPE-6: the shader's global root signature must be the one bound for the dispatch.
 void checkGlobalSignature(ThreadState& ts, const Site& site, const ProgramEntry& entry) {
     const DispatchState& ds = *ts.dispatch;
@@ -241,6 +298,17 @@ void checkPayload(ThreadState& ts, const Site& site, const ShaderExport& shader,
 
 void invoke(ThreadState& ts, Invocation& inv, void* payload, const void* attributes) {
     ts.stats.invocations[size_t(inv.stage)]++;
+    if (observer(ts)) {
+        TraceEvent e = event(ts, TraceEvent::Kind::ShaderCall, inv.depth);
+        e.stage = inv.stage;
+        e.exportName = inv.shader->name;
+        if (inv.record) {
+            e.recordIndex = inv.record->index;
+            e.recordAddress = inv.record->address;
+        }
+        if (inv.hit) setHit(e, *inv.hit->instance, inv.hit->instanceIndex, inv.hit->geometryIndex, inv.hit->primitiveIndex);
+        observer(ts)->onEvent(e);
+    }
     ShaderContext ctx(inv);
     struct ChainEntry {  // pops on every exit, including non-local ones
         std::vector<const ShaderExport*>& chain;
@@ -268,7 +336,14 @@ bool isOpaque(uint32_t geometryFlags, uint32_t instanceFlags, uint32_t rayFlags)
     return opaque;
 }
 
-void commit(RayState& rs, const HitInfo& hit) {  // TRV-4 step 4
+void commit(const ThreadState& ts, RayState& rs, const HitInfo& hit) {  // TRV-4 step 4
+    if (observer(ts)) {
+        TraceEvent e = event(ts, TraceEvent::Kind::Commit, rs.depth);
+        setHit(e, *hit.instance, hit.instanceIndex, hit.geometryIndex, hit.primitiveIndex);
+        e.t = hit.t;
+        e.hitKind = hit.hitKind;
+        observer(ts)->onEvent(e);
+    }
     rs.committed = true;
     rs.committedHit = hit;
     rs.tCurrent = hit.t;
@@ -288,14 +363,24 @@ AnyHitOutcome runAnyHit(ThreadState& ts, RayState& rs, const RecordView& record,
     inv.depth = rs.depth;
     checkGlobalSignature(ts, siteOf(inv), *record.entry);
     checkPayload(ts, siteOf(inv), *inv.shader, rs.payloadType);
+    AnyHitOutcome outcome = AnyHitOutcome::Accept;
     try {
         invoke(ts, inv, rs.payload, candidate.attributes);
     } catch (const IgnoreHitSignal&) {
-        return AnyHitOutcome::Ignore;
+        outcome = AnyHitOutcome::Ignore;
     } catch (const AcceptHitAndEndSearchSignal&) {
-        return AnyHitOutcome::AcceptAndEnd;
+        outcome = AnyHitOutcome::AcceptAndEnd;
     }
-    return AnyHitOutcome::Accept;
+    if (observer(ts)) {
+        TraceEvent e = event(ts, TraceEvent::Kind::AnyHit, rs.depth);
+        setHit(e, *candidate.instance, candidate.instanceIndex, candidate.geometryIndex, candidate.primitiveIndex);
+        e.t = candidate.t;
+        e.note = outcome == AnyHitOutcome::Ignore         ? "IgnoreHit: the candidate is dropped"
+                 : outcome == AnyHitOutcome::AcceptAndEnd ? "AcceptHitAndEndSearch: commit and end the search"
+                                                          : "accept (returned normally)";
+        observer(ts)->onEvent(e);
+    }
+    return outcome;
 }
 
 }  // namespace
@@ -307,6 +392,19 @@ bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attrib
     RayState& rs = *inv.ray;
     const Site site = siteOf(inv);
     const ProgramEntry& group = *inv.record->entry;
+    if (observer(ts)) {
+        TraceEvent e = event(ts, TraceEvent::Kind::ReportHit, rs.depth);
+        setHit(e, *inv.hit->instance, inv.hit->instanceIndex, inv.hit->geometryIndex, inv.hit->primitiveIndex);
+        e.t = tHit;
+        e.hitKind = hitKind;
+        e.accepted = !std::isnan(tHit) && type == group.attributes && tHit >= rs.ray.TMin && tHit <= rs.tCurrent;
+        e.note = std::isnan(tHit)               ? "rejected: THit is NaN (IS-3)"
+                 : !(type == group.attributes)  ? "rejected: the attributes are not the hit group's type (IS-5)"
+                 : !e.accepted                  ? "ignored: THit outside [RayTMin, RayTCurrent] (IS-3)"
+                 : !inv.candidateOpaque && group.anyHit ? "in range: the any-hit shader decides (IS-7)"
+                                                        : "in range: committed (IS-6)";
+        observer(ts)->onEvent(e);
+    }
     if (std::isnan(tHit)) {
         raise(ts, site, diag("IS-3", "ReportHit called with a NaN THit; the hit is rejected").value("THit", tHit));
         return false;
@@ -330,11 +428,11 @@ bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attrib
     if (!inv.candidateOpaque && group.anyHit) {  // IS-7: the AHS runs inside ReportHit
         switch (runAnyHit(ts, rs, *inv.record, candidate)) {
             case AnyHitOutcome::Ignore: return false;
-            case AnyHitOutcome::AcceptAndEnd: commit(rs, candidate); throw EndSearchSignal{};
+            case AnyHitOutcome::AcceptAndEnd: commit(ts, rs, candidate); throw EndSearchSignal{};
             case AnyHitOutcome::Accept: break;
         }
     }
-    commit(rs, candidate);  // IS-6
+    commit(ts, rs, candidate);  // IS-6
     if (rs.effectiveFlags & RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH) throw EndSearchSignal{};  // FLAG-8
     return true;
 }
@@ -342,7 +440,10 @@ bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attrib
 namespace {
 
 void processTriangle(ThreadState& ts, RayState& rs, const Candidate& c, const Site& site) {
-    if (!(rs.ray.TMin < c.t && c.t < rs.tCurrent)) return;  // TRV-2: open interval, current TCurrent
+    if (!(rs.ray.TMin < c.t && c.t < rs.tCurrent)) {  // TRV-2: open interval, current TCurrent
+        if (observer(ts)) emitSkipped(ts, rs, "t outside (RayTMin, RayTCurrent) (TRV-2)");
+        return;
+    }
     const BuiltInstance& inst = rs.tlas->instances()[c.instanceIndex];
     const BuiltGeometry& geom = inst.blas->geometries()[c.geometryIndex];
     const uint32_t instanceFlags = inst.desc.Flags;
@@ -355,12 +456,20 @@ void processTriangle(ThreadState& ts, RayState& rs, const Candidate& c, const Si
     if (instanceFlags & INSTANCE_FLAG_TRIANGLE_FRONT_COUNTERCLOCKWISE) front = !front;
 
     if (!(instanceFlags & INSTANCE_FLAG_TRIANGLE_CULL_DISABLE)) {  // FLAG-10, FACE-5
-        if ((rs.effectiveFlags & RAY_FLAG_CULL_BACK_FACING_TRIANGLES) && !front) return;
-        if ((rs.effectiveFlags & RAY_FLAG_CULL_FRONT_FACING_TRIANGLES) && front) return;
+        if ((rs.effectiveFlags & RAY_FLAG_CULL_BACK_FACING_TRIANGLES) && !front) {
+            if (observer(ts)) emitSkipped(ts, rs, "back face culled: CULL_BACK_FACING_TRIANGLES (FLAG-10)");
+            return;
+        }
+        if ((rs.effectiveFlags & RAY_FLAG_CULL_FRONT_FACING_TRIANGLES) && front) {
+            if (observer(ts)) emitSkipped(ts, rs, "front face culled: CULL_FRONT_FACING_TRIANGLES (FLAG-10)");
+            return;
+        }
     }
     const bool opaque = isOpaque(geom.flags, instanceFlags, rs.effectiveFlags);
-    if ((rs.effectiveFlags & RAY_FLAG_CULL_OPAQUE) && opaque) return;       // FLAG-11
-    if ((rs.effectiveFlags & RAY_FLAG_CULL_NON_OPAQUE) && !opaque) return;
+    if (((rs.effectiveFlags & RAY_FLAG_CULL_OPAQUE) && opaque) || ((rs.effectiveFlags & RAY_FLAG_CULL_NON_OPAQUE) && !opaque)) {
+        if (observer(ts)) emitSkipped(ts, rs, opaque ? "opaque, culled: CULL_OPAQUE (FLAG-11)" : "non-opaque, culled: CULL_NON_OPAQUE (FLAG-11)");
+        return;  // FLAG-11
+    }
 
     HitInfo hit;
     hit.instance = &inst;
@@ -391,17 +500,22 @@ void processTriangle(ThreadState& ts, RayState& rs, const Candidate& c, const Si
             }
         }
     }
-    commit(rs, hit);
+    commit(ts, rs, hit);
     if (endSearch || (rs.effectiveFlags & RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH)) rs.searchEnded = true;  // FLAG-8
 }
 
 void processProcedural(ThreadState& ts, RayState& rs, const Candidate& c, const Site& site) {
-    if (c.key > rs.tCurrent) return;  // the box no longer overlaps [TMin, TCurrent]
+    if (c.key > rs.tCurrent) {  // the box no longer overlaps [TMin, TCurrent]
+        if (observer(ts)) emitSkipped(ts, rs, "the box starts beyond RayTCurrent: no intersection shader call");
+        return;
+    }
     const BuiltInstance& inst = rs.tlas->instances()[c.instanceIndex];
     const BuiltGeometry& geom = inst.blas->geometries()[c.geometryIndex];
     const bool opaque = isOpaque(geom.flags, inst.desc.Flags, rs.effectiveFlags);
-    if ((rs.effectiveFlags & RAY_FLAG_CULL_OPAQUE) && opaque) return;  // FLAG-11: before the IS
-    if ((rs.effectiveFlags & RAY_FLAG_CULL_NON_OPAQUE) && !opaque) return;
+    if (((rs.effectiveFlags & RAY_FLAG_CULL_OPAQUE) && opaque) || ((rs.effectiveFlags & RAY_FLAG_CULL_NON_OPAQUE) && !opaque)) {
+        if (observer(ts)) emitSkipped(ts, rs, opaque ? "opaque, culled: CULL_OPAQUE (FLAG-11)" : "non-opaque, culled: CULL_NON_OPAQUE (FLAG-11)");
+        return;  // FLAG-11: before the IS
+    }
 
     HitInfo box;
     box.instance = &inst;
@@ -418,7 +532,10 @@ void processProcedural(ThreadState& ts, RayState& rs, const Candidate& c, const 
     if (!lookupRecord(ts, site, ProgramEntry::Kind::HitGroup, ts.dispatch->desc->HitGroupTable, terms.index, record,
                       &lookup))
         return;
-    if (!record.entry) return;  // OPQ-4: a NULL hit group has no IS, so no hit
+    if (!record.entry) {  // OPQ-4: a NULL hit group has no IS, so no hit
+        if (observer(ts)) emitSkipped(ts, rs, "NULL hit group: no intersection shader, no hit (OPQ-4)");
+        return;
+    }
 
     Invocation inv;
     inv.stage = ShaderStage::Intersection;
@@ -578,6 +695,32 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
     }
     std::memcpy(local, payload, payloadType.size);
     rs.payload = local;
+    auto emitRay = [&](TraceEvent::Kind kind) {
+        TraceEvent e = event(ts, kind, rs.depth);
+        e.accelerationStructure = asAddress;
+        e.ray = ray;
+        e.rayFlags = rayFlags;
+        e.effectiveFlags = rs.effectiveFlags;
+        e.instanceInclusionMask = mask;
+        e.rayContribution = r;
+        e.multiplier = m;
+        e.missShaderIndex = missIndex;
+        e.committed = rs.committed;
+        if (rs.committed) {
+            const HitInfo& h = rs.committedHit;
+            setHit(e, *h.instance, h.instanceIndex, h.geometryIndex, h.primitiveIndex);
+            e.t = h.t;
+            e.hitKind = h.hitKind;
+        }
+        if (kind == TraceEvent::Kind::TraceRayEnd && rs.committed && (rs.effectiveFlags & RAY_FLAG_SKIP_CLOSEST_HIT_SHADER))
+            e.note = "closest hit skipped: SKIP_CLOSEST_HIT_SHADER (FLAG-9)";
+        e.payloadTypeId = payloadType.id;
+        e.payloadTypeName = payloadType.mangledName;
+        e.payload = local;
+        e.payloadSize = payloadType.size;
+        observer(ts)->onEvent(e);
+    };
+    if (observer(ts)) emitRay(TraceEvent::Kind::TraceRay);
 
     ts.stats.raysTraced++;
     if (ts.stats.raysPerDepth.size() <= rs.depth) ts.stats.raysPerDepth.resize(rs.depth + 1);
@@ -634,6 +777,13 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
         // while shaders of this ray may run, which ends before the CHS starts.
         for (size_t i = 0; i < ts.candidates.size() && !rs.searchEnded; ++i) {
             const Candidate c = ts.candidates[i];
+            if (observer(ts)) {
+                TraceEvent e = event(ts, TraceEvent::Kind::Candidate, rs.depth);
+                setHit(e, rs.tlas->instances()[c.instanceIndex], c.instanceIndex, c.geometryIndex, c.primitiveIndex);
+                e.procedural = c.procedural;
+                e.t = c.procedural ? c.key : c.t;
+                observer(ts)->onEvent(e);
+            }
             if (c.procedural) processProcedural(ts, rs, c, site);
             else processTriangle(ts, rs, c, site);
         }
@@ -681,6 +831,7 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
             invoke(ts, inv, rs.payload, nullptr);
         }
     }
+    if (observer(ts)) emitRay(TraceEvent::Kind::TraceRayEnd);
     std::memcpy(payload, local, payloadType.size);
 }
 
@@ -961,6 +1112,14 @@ DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObj
                                .hex("StartAddress", range.StartAddress)
                                .value("SizeInBytes", range.SizeInBytes));
     }
+    LaunchRegion region{0, 0, desc.Width, desc.Height};
+    if (options.region) {
+        region = *options.region;
+        REFRAY_CHECK(uint64_t(region.x) + region.width <= desc.Width && uint64_t(region.y) + region.height <= desc.Height,
+                     "the launch region " << region.width << "x" << region.height << " at (" << region.x << ", "
+                                          << region.y << ") is not inside the " << desc.Width << "x" << desc.Height
+                                          << " dispatch");
+    }
     if (globalArguments && globalArguments->signature()->isLocal())
         throw DxrError(diag("PIPE-7", "the root signature bound for the dispatch is a local root signature")
                            .value("signature", globalArguments->signature()->name()));
@@ -1012,7 +1171,7 @@ DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObj
     tbb::task_arena arena(arenaThreads);
     arena.execute([&] {
         tbb::parallel_for(
-            tbb::blocked_range2d<uint32_t>(0, desc.Height, tile, 0, desc.Width, tile),
+            tbb::blocked_range2d<uint32_t>(region.y, region.y + region.height, tile, region.x, region.x + region.width, tile),
             [&](const tbb::blocked_range2d<uint32_t>& range) {
                 detail::ThreadState& ts = threadStates.local();
                 for (uint32_t z = 0; z < desc.Depth; ++z) {

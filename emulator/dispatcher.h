@@ -3,9 +3,11 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/progress.h"
+#include "emulator/trace.h"
 #include "emulator/validation.h"
 
 namespace refray::dxr {
@@ -28,6 +30,12 @@ enum class OnError : uint8_t {
     Continue,  // record every error and apply the fallback its rule documents
 };
 
+// A rectangle of launch indices (z = 0 .. Depth-1 all run). DispatchRaysIndex() and
+// DispatchRaysDimensions() keep their full-dispatch values.
+struct LaunchRegion {
+    uint32_t x = 0, y = 0, width = 0, height = 0;
+};
+
 struct DispatchOptions {
     uint32_t threads = 0;  // 0: every hardware thread
     uint32_t tileSize = 8;
@@ -35,6 +43,10 @@ struct DispatchOptions {
     TraversalOrder order = TraversalOrder::Ordered;
     uint64_t adversarialSeed = 0;
     Progress* progress = nullptr;  // advanced once per tile
+    // Only these launch indices run (explain one pixel); unset: all of them. Must lie inside the dispatch.
+    std::optional<LaunchRegion> region;
+    // Receives every trace event (emulator/trace.h); null: nothing is recorded.
+    TraceObserver* observer = nullptr;
 };
 
 struct DispatchStats {

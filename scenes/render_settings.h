@@ -31,6 +31,10 @@ struct RenderSettings {
     // fall on a regular grid inside each output pixel, averaged in float (the shaders' own ray generation runs
     // unchanged). 1 is the GPU's image.
     uint32_t spp = 1;
+    // Only these pixels of the dispatch run (refray explain); unset: all. Needs spp 1.
+    std::optional<dxr::LaunchRegion> region;
+    // Receives the trace events of the dispatch (emulator/trace.h); null: nothing is recorded.
+    dxr::TraceObserver* observer = nullptr;
 };
 
 // Runs DispatchRays for a width x height dispatch with the settings' threads, order, error mode and progress.
@@ -42,9 +46,13 @@ inline dxr::DispatchResult dispatchWithSettings(dxr::Device& device, const dxr::
     options.order = settings.order;
     options.adversarialSeed = settings.adversarialSeed;
     options.onError = settings.onError;
+    options.region = settings.region;
+    options.observer = settings.observer;
     std::unique_ptr<Progress> progress;
     if (settings.progress) {
-        progress = std::make_unique<Progress>("render", uint64_t(desc.Width) * desc.Height * desc.Depth, settings.progress);
+        const uint64_t launches = settings.region ? uint64_t(settings.region->width) * settings.region->height * desc.Depth
+                                                  : uint64_t(desc.Width) * desc.Height * desc.Depth;
+        progress = std::make_unique<Progress>("render", launches, settings.progress);
         options.progress = progress.get();
     }
     dxr::DispatchResult result = device.dispatchRays(desc, pipeline, globals, options);

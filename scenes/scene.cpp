@@ -106,7 +106,10 @@ Scene::Pipeline& Scene::pipelineFor(Precision precision) {
 
     StateObjectDesc so;
     so.name = desc_.name + " (" + std::string(procedural::toString(precision)) + ")";
-    so.libraries = {{binding.make(precision), {}}};
+    std::vector<procedural::TraceRayArguments> traceRay;  // what the shaders pass, per ray type
+    for (const RayTypeDesc& t : desc_.rayTypes)
+        traceRay.push_back({t.rayContribution, t.multiplier, t.missShaderIndex, t.instanceInclusionMask});
+    so.libraries = {{binding.make(precision, traceRay), {}}};
     so.hitGroups = desc_.hitGroups;
     for (size_t i = 0; i < localSignatures_.size(); ++i)
         if (!desc_.localAssociations[i].empty())
@@ -196,6 +199,8 @@ GpuVirtualAddress Scene::generateBuffer(const BufferDesc& b, const CameraDesc& c
 
 RenderResult Scene::render(const RenderSettings& settings) {
     const uint32_t k = sampleGridSize(settings.spp);
+    REFRAY_CHECK(k == 1 || !settings.region, "a launch region (one pixel's explanation) needs one sample per pixel, got --spp "
+                                                 << settings.spp);
     const uint32_t width = settings.width * k, height = settings.height * k;
     REFRAY_CHECK(settings.width > 0 && settings.height > 0 && width <= 65536 && height <= 65536,
                  "the dispatch " << width << "x" << height << " (size x sqrt(spp)) is outside 1x1 .. 65536x65536");

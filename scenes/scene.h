@@ -22,6 +22,8 @@ public:
     const SceneDesc& desc() const { return desc_; }
     dxr::Device& device() { return device_; }
     dxr::GpuVirtualAddress tlas() const { return tlas_; }
+    // The GPU address of BLAS `index` (SceneDesc::blases order).
+    dxr::GpuVirtualAddress blasAddress(size_t index) const { return blasAddresses_.at(index); }
     // The state object and tables of `precision` (built on first use).
     const dxr::StateObjectPtr& pipeline(procedural::Precision precision) { return pipelineFor(precision).stateObject; }
     const dxr::DispatchRaysDesc& tables(procedural::Precision precision) { return pipelineFor(precision).tables; }

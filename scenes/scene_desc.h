@@ -82,6 +82,26 @@ struct RayTypeDesc {
     std::string name;
     std::string miss;     // the miss export of this ray type (auto layout: miss record = ray type index)
     std::string payload;  // the payload struct's name, checked against the miss export's declaration
+    // The TraceRay arguments the shaders pass for this ray type (IDX-1, IDX-7): the library's own values (r, the
+    // number of ray types, r, ~0 for ray type r) unless the ray type's "traceRay" overrides them.
+    uint32_t rayContribution = 0;  // RayContributionToHitGroupIndex
+    uint32_t multiplier = 0;       // MultiplierForGeometryContributionToHitGroupIndex
+    uint32_t missShaderIndex = 0;  // MissShaderIndex
+    uint32_t instanceInclusionMask = ~0u;  // InstanceInclusionMask (only the low 8 bits count, INST-4)
+};
+
+// A struct a scene file declares for root constants ("structs"), kept so tools can decode record bytes.
+struct StructField {
+    enum class Kind : uint8_t { Float, Int, Uint };
+    std::string name;
+    Kind kind = Kind::Float;
+    uint32_t components = 1;
+    uint32_t offset = 0;  // in dwords
+};
+struct StructDesc {
+    std::string name;
+    std::vector<StructField> fields;
+    uint32_t dwords = 0;
 };
 
 // One hit-group record: ⟨hit group, local root signature, root arguments⟩.
@@ -91,6 +111,7 @@ struct RecordDesc {
     struct Argument {
         uint32_t parameter = 0;
         std::vector<uint32_t> dwords;  // root constants
+        int32_t structIndex = -1;      // root constants: index into SceneDesc::structs, -1: plain floats
         int32_t buffer = -1;           // root descriptor: a buffer's address
     };
     std::vector<Argument> arguments;
@@ -123,6 +144,8 @@ struct SceneDesc {
     std::string source;
     std::string shaderLibrary;
     LayoutMode layout = LayoutMode::Auto;
+
+    std::vector<StructDesc> structs;  // the file's "structs", in file order
 
     // Pipeline.
     std::string rayGeneration;

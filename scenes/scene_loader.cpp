@@ -82,20 +82,9 @@ uint32_t flagSet(const Value& value, const std::vector<std::pair<std::string, ui
 
 // ---- Struct layouts and constant values ---------------------------------------------------------------
 
-enum class ScalarKind { Float, Int, Uint };
-
-struct Field {
-    std::string name;
-    ScalarKind kind = ScalarKind::Float;
-    uint32_t components = 1;
-    uint32_t offset = 0;  // in dwords
-};
-
-struct StructLayout {
-    std::string name;
-    std::vector<Field> fields;
-    uint32_t dwords = 0;
-};
+using ScalarKind = StructField::Kind;
+using Field = StructField;
+using StructLayout = StructDesc;
 
 Field parseFieldType(const Value& value) {
     static const std::vector<std::string> types = {"float",  "float2", "float3", "float4", "int",  "int2",
@@ -180,7 +169,7 @@ public:
             libraryValue.fail(e.what());
         }
         scene_.shaderLibrary = binding_->name;
-        library_ = binding_->make(procedural::Precision::Float);
+        library_ = binding_->make(procedural::Precision::Float, binding_->traceRayDefaults);
 
         if (const Value* v = top.optional("layout")) {
             const uint32_t mode = resolveName(*v, {"auto", "explicit"}, "layout");
@@ -244,7 +233,8 @@ private:
             }
             if (layout.dwords == 0) m.value.fail("struct " + inQuotes(m.key) + " has no fields");
             structNames_.push_back(m.key);
-            structs_.push_back(std::move(layout));
+            structs_.push_back(layout);
+            scene_.structs.push_back(std::move(layout));
         }
     }
 
@@ -327,14 +317,38 @@ private:
             if (declared != t.payload)
                 payload.fail("ray type " + inQuotes(t.name) + " says its payload is " + inQuotes(t.payload) +
                              ", but its miss shader " + inQuotes(t.miss) + " takes " + inQuotes(declared));
+            setTraceRayArguments(t, uint32_t(scene_.rayTypes.size()), r.optional("traceRay"));
             r.finish();
             scene_.rayTypes.push_back(t);
         }
         if (scene_.rayTypes.empty()) value.fail("a scene needs at least one ray type");
         if (scene_.rayTypes.size() != binding_->rayTypeCount)
             value.fail("the " + binding_->name + " shaders trace " + std::to_string(binding_->rayTypeCount) +
-                       " ray types (ray contribution r, multiplier " + std::to_string(binding_->rayTypeCount) +
-                       ", miss index r); the scene declares " + std::to_string(scene_.rayTypes.size()));
+                       " ray types (by default ray contribution r, multiplier " +
+                       std::to_string(binding_->rayTypeCount) + ", miss index r); the scene declares " +
+                       std::to_string(scene_.rayTypes.size()));
+    }
+
+    // The TraceRay arguments the shaders pass for ray type `index`: what the library's HLSL passes, each replaced by
+    // the ray type's "traceRay" where it gives one. Values above DXR's bit widths are kept: the emulator masks them
+    // when the ray is traced (IDX-2 warns about R and M).
+    void setTraceRayArguments(RayTypeDesc& t, uint32_t index, const Value* traceRay) {
+        procedural::TraceRayArguments a{index, binding_->rayTypeCount, index, ~0u};
+        if (index < binding_->traceRayDefaults.size()) a = binding_->traceRayDefaults[index];
+        if (traceRay) {
+            std::string what = "traceRay of ray type ";
+            what += inQuotes(t.name);
+            ObjectReader r(*traceRay, std::move(what));
+            if (const Value* v = r.optional("rayContribution")) a.rayContribution = v->asUint32();
+            if (const Value* v = r.optional("multiplier")) a.multiplier = v->asUint32();
+            if (const Value* v = r.optional("missShaderIndex")) a.missShaderIndex = v->asUint32();
+            if (const Value* v = r.optional("instanceInclusionMask")) a.instanceInclusionMask = v->asUint32();
+            r.finish();
+        }
+        t.rayContribution = a.rayContribution;
+        t.multiplier = a.multiplier;
+        t.missShaderIndex = a.missShaderIndex;
+        t.instanceInclusionMask = a.instanceInclusionMask;
     }
 
     void parseHitGroups(const Value& value) {
@@ -851,6 +865,7 @@ private:
             const dxr::RootParameter& param = sig.parameters[p];
             if (param.parameterType == dxr::RootParameterType::Constants32Bit) {
                 a.dwords = constantValue(v, pi.structIndex, param.num32BitValues, "argument " + inQuotes(pi.name));
+                a.structIndex = pi.structIndex;
             } else if (param.parameterType == dxr::RootParameterType::DescriptorTable) {
                 v.fail("local descriptor tables are not supported in scene files yet; bind buffers as root descriptors");
             } else {

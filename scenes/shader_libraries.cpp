@@ -1,5 +1,6 @@
 #include "scenes/shader_libraries.h"
 
+#include <array>
 #include <cstring>
 
 #include "core/error.h"
@@ -31,6 +32,22 @@ std::vector<uint8_t> procedurayConstants(const SceneConstantsInput& in) {
     return bytesOf(cb);
 }
 
+// The per-ray-type list of a scene as a library's TraceRayArgumentSet.
+procedural::TraceRayArgumentSet argumentSet(const std::vector<procedural::TraceRayArguments>& perRayType,
+                                            const char* library) {
+    REFRAY_CHECK(perRayType.size() == procedural::kTraceRayTypeCount,
+                 "the " << library << " shaders trace " << procedural::kTraceRayTypeCount
+                        << " ray types; got TraceRay arguments for " << perRayType.size());
+    procedural::TraceRayArgumentSet set;
+    for (uint32_t r = 0; r < procedural::kTraceRayTypeCount; ++r) set[r] = perRayType[r];
+    return set;
+}
+
+template <size_t N>
+std::vector<procedural::TraceRayArguments> perRayType(const std::array<procedural::TraceRayArguments, N>& rayTypes) {
+    return {rayTypes.begin(), rayTypes.end()};
+}
+
 std::vector<uint8_t> d3d12Constants(const SceneConstantsInput& in) {
     procedural::d3d12::SceneConstantBuffer cb{};
     cb.projectionToWorld = in.projectionToWorld;
@@ -49,11 +66,17 @@ const std::vector<ShaderLibraryBinding>& shaderLibraries() {
     static const std::vector<ShaderLibraryBinding> libraries = {
         {"d3d12-procedural-geometry",
          "Microsoft D3D12RaytracingProceduralGeometry Raytracing.hlsl (procedural/d3d12/)",
-         [](procedural::Precision p) { return procedural::d3d12::makeD3D12ShaderLibrary(p); }, d3d12Constants, false,
-         procedural::d3d12::RayType::Count},
+         [](procedural::Precision p, const std::vector<procedural::TraceRayArguments>& traceRay) {
+             return procedural::d3d12::makeD3D12ShaderLibrary(p, argumentSet(traceRay, "d3d12-procedural-geometry"));
+         },
+         d3d12Constants, false, procedural::d3d12::RayType::Count,
+         perRayType(procedural::d3d12::defaultTraceRayArguments().rayTypes)},
         {"proceduray", "Proceduray MandelJuliaPac Raytracing.hlsl (procedural/proceduray/)",
-         [](procedural::Precision p) { return procedural::proceduray::makeProcedurayShaderLibrary(p); },
-         procedurayConstants, true, procedural::proceduray::RayTypeCount},
+         [](procedural::Precision p, const std::vector<procedural::TraceRayArguments>& traceRay) {
+             return procedural::proceduray::makeProcedurayShaderLibrary(p, argumentSet(traceRay, "proceduray"));
+         },
+         procedurayConstants, true, procedural::proceduray::RayTypeCount,
+         perRayType(procedural::proceduray::defaultTraceRayArguments().rayTypes)},
     };
     return libraries;
 }

@@ -12,6 +12,7 @@
 #include "emulator/state_object.h"
 #include "procedural/precision.h"
 #include "procedural/sample_layout.h"
+#include "procedural/trace_ray_parameters.h"
 
 namespace refray::scenes {
 
@@ -33,12 +34,19 @@ struct SceneConstantsInput {
 struct ShaderLibraryBinding {
     std::string name;         // what scene files write in "shaderLibrary"
     std::string description;  // which HLSL it ports
-    std::function<std::shared_ptr<dxr::ShaderLibrary>(procedural::Precision)> make;
+    // Makes the library with its shaders' TraceRay arguments, one entry per ray type (exactly rayTypeCount; other
+    // counts throw refray::Error). `traceRayDefaults` gives the library's own.
+    std::function<std::shared_ptr<dxr::ShaderLibrary>(procedural::Precision,
+                                                      const std::vector<procedural::TraceRayArguments>&)>
+        make;
     // The bytes of the library's SceneConstantBuffer (its C++ struct, padding zeroed).
     std::function<std::vector<uint8_t>(const SceneConstantsInput&)> sceneConstants;
     bool hasDebugFlag = false;
-    // The shaders trace ray type r with RayContributionToHitGroupIndex r, multiplier rayTypeCount and miss index r.
+    // The number of ray types the shaders trace.
     uint32_t rayTypeCount = 0;
+    // What the HLSL passes to TraceRay for ray type r: RayContributionToHitGroupIndex r, multiplier rayTypeCount,
+    // miss index r and its instance inclusion mask (~0 for both libraries), rayTypeCount entries.
+    std::vector<procedural::TraceRayArguments> traceRayDefaults;
 };
 
 // The registered libraries, in name order.

@@ -1,16 +1,16 @@
 #include "tools/compare_command.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 #include "core/error.h"
+#include "core/strings.h"
+#include "tools/cli_common.h"
 
 namespace refray::tools {
 
@@ -72,74 +72,13 @@ std::string verdictLine(const CompareResult& r) {
     return out.str();
 }
 
-// --- HTML ------------------------------------------------------------------------
-
-std::string escapeHtml(const std::string& text) {
-    std::string out;
-    out.reserve(text.size());
-    for (char c : text) {
-        switch (c) {
-            case '&': out += "&amp;"; break;
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '"': out += "&quot;"; break;
-            default: out += c;
-        }
-    }
-    return out;
-}
-
-std::string base64(const std::string& bytes) {
-    static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    out.reserve((bytes.size() + 2) / 3 * 4);
-    size_t i = 0;
-    for (; i + 2 < bytes.size(); i += 3) {
-        const uint32_t v = uint32_t(uint8_t(bytes[i])) << 16 | uint32_t(uint8_t(bytes[i + 1])) << 8 | uint8_t(bytes[i + 2]);
-        out += kAlphabet[v >> 18];
-        out += kAlphabet[(v >> 12) & 63];
-        out += kAlphabet[(v >> 6) & 63];
-        out += kAlphabet[v & 63];
-    }
-    if (i + 1 == bytes.size()) {
-        const uint32_t v = uint32_t(uint8_t(bytes[i])) << 16;
-        out += kAlphabet[v >> 18];
-        out += kAlphabet[(v >> 12) & 63];
-        out += "==";
-    } else if (i + 2 == bytes.size()) {
-        const uint32_t v = uint32_t(uint8_t(bytes[i])) << 16 | uint32_t(uint8_t(bytes[i + 1])) << 8;
-        out += kAlphabet[v >> 18];
-        out += kAlphabet[(v >> 12) & 63];
-        out += kAlphabet[(v >> 6) & 63];
-        out += '=';
-    }
-    return out;
-}
-
-// The image as a PNG data URI (what an R8G8B8A8_UNORM target holds), through a
-// temporary file because core/image writes files only.
-std::string pngDataURI(const Image& image) {
-    static std::atomic<unsigned> counter{0};
-    const auto path = std::filesystem::temp_directory_path() /
-                      ("refray-compare-" + std::to_string(getpid()) + "-" + std::to_string(counter++) + ".png");
-    Image bare(image.width(), image.height());
-    bare.pixels() = image.pixels();
-    writeImage(path.string(), bare);
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream bytes;
-    bytes << in.rdbuf();
-    in.close();
-    std::error_code ignored;
-    std::filesystem::remove(path, ignored);
-    return "data:image/png;base64," + base64(bytes.str());
-}
 
 // Small images are shown enlarged by a whole factor (pixelated) so single pixels show.
 std::string imageTag(const char* cssClass, const Image& image, const std::string& alt) {
     const uint32_t factor = std::max(1u, (256u + image.width() - 1) / std::max(1u, image.width()));
     std::ostringstream out;
     out << "<img class=\"" << cssClass << "\" width=\"" << image.width() * factor << "\" height=\""
-        << image.height() * factor << "\" alt=\"" << escapeHtml(alt) << "\" src=\"" << pngDataURI(image) << "\">";
+        << image.height() * factor << "\" alt=\"" << htmlEscape(alt) << "\" src=\"" << pngDataURI(image) << "\">";
     return out.str();
 }
 
@@ -313,7 +252,7 @@ void writeCompareReport(const std::string& path, CompareVerdict overall, const s
     html << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>refray compare: " << verdict
          << "</title>\n<style>" << kStyle << "</style>\n</head>\n<body>\n";
     html << "<h1>refray compare: <span id=\"verdict\" class=\"badge " << verdict << "\">" << verdict << "</span></h1>\n";
-    html << "<p id=\"summary\">" << escapeHtml(summary) << "</p>\n";
+    html << "<p id=\"summary\">" << htmlEscape(summary) << "</p>\n";
     html << "<p>Hover over a candidate to see the reference in its place. Diffs are heat maps through the magma "
             "ramp: black is no difference, pale yellow the largest.</p>\n";
     html << "<table id=\"comparisons\">\n<thead><tr><th>reference</th><th>candidate</th><th>diff</th><th>numbers</th>"
@@ -321,14 +260,14 @@ void writeCompareReport(const std::string& path, CompareVerdict overall, const s
     for (const CompareReportRow& row : rows) {
         const std::string rowVerdict(toString(row.result->verdict));
         html << "<tr class=\"comparison " << rowVerdict << "\" data-verdict=\"" << rowVerdict << "\" data-reference=\""
-             << escapeHtml(row.referencePath) << "\">\n";
+             << htmlEscape(row.referencePath) << "\">\n";
         html << "<td>" << imageTag("reference", *row.reference, "reference " + row.referencePath)
-             << "<div class=\"caption\">" << escapeHtml(row.referencePath) << "</div></td>\n";
+             << "<div class=\"caption\">" << htmlEscape(row.referencePath) << "</div></td>\n";
         html << "<td>" << imageTag("candidate", *row.candidate, "candidate " + row.candidatePath)
-             << "<div class=\"caption\">" << escapeHtml(row.candidatePath)
+             << "<div class=\"caption\">" << htmlEscape(row.candidatePath)
              << "</div><div class=\"caption showing\">showing: candidate</div></td>\n";
         html << "<td>";
-        if (row.result->diffImage.empty()) html << "<div class=\"caption\">no diff: " << escapeHtml(row.result->mismatch) << "</div>";
+        if (row.result->diffImage.empty()) html << "<div class=\"caption\">no diff: " << htmlEscape(row.result->mismatch) << "</div>";
         else html << imageTag("diff", row.result->diffImage, "diff") << "<div class=\"caption\">diff</div>";
         html << "</td>\n";
         html << "<td><span class=\"badge row-verdict " << rowVerdict << "\">" << rowVerdict << "</span>"
@@ -336,7 +275,7 @@ void writeCompareReport(const std::string& path, CompareVerdict overall, const s
                                                                              : " <span class=\"matched\">best match</span>")
                              : "")
              << "<pre>"
-             << escapeHtml(row.result->describe()) << "</pre></td>\n</tr>\n";
+             << htmlEscape(row.result->describe()) << "</pre></td>\n</tr>\n";
     }
     html << "</tbody>\n</table>\n<script>" << kScript << "</script>\n</body>\n</html>\n";
 

@@ -4,9 +4,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
-#include <regex>
 #include <string>
-#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 
@@ -15,38 +13,25 @@
 #include "emulator/validation.h"
 #include "procedural/precision.h"
 #include "scenes/builtin_scene.h"
+#include "core/strings.h"
 #include "scenes/golden.h"
+#include "scenes/index_map.h"
 #include "scenes/order_check.h"
 #include "scenes/scene.h"
+#include "tools/cli_common.h"
 #include "tools/compare_command.h"
+#include "tools/explain_command.h"
+#include "tools/table_command.h"
 #include "tools/version.h"
 
 namespace {
 
 using namespace refray;
 
-struct Size {
-    uint32_t width = 640, height = 360;
-};
-
-Size parseSize(const std::string& text) {
-    static const std::regex pattern(R"((\d+)x(\d+))");
-    std::smatch m;
-    REFRAY_CHECK(std::regex_match(text, m, pattern), "--size expects WIDTHxHEIGHT (e.g. 640x360), got '" << text << "'");
-    const unsigned long w = std::stoul(m[1]), h = std::stoul(m[2]);
-    REFRAY_CHECK(w > 0 && h > 0 && w <= 16384 && h <= 16384,
-                 "--size " << text << " is outside 1x1 .. 16384x16384");
-    return {uint32_t(w), uint32_t(h)};
-}
-
-Progress::Sink terminalProgress() {
-    if (!isatty(STDERR_FILENO)) return {};
-    return [](const ProgressState& s) {
-        std::fprintf(stderr, "\r%s", formatProgressBar(s).c_str());
-        if (s.finished) std::fputc('\n', stderr);
-        std::fflush(stderr);
-    };
-}
+using tools::parseSize;
+using tools::Size;
+using tools::terminalProgress;
+using tools::writeOutput;
 
 void printStats(const scenes::RenderResult& r, const Size& size) {
     const auto& st = r.dispatch.stats;
@@ -74,14 +59,30 @@ struct RenderOptions {
     std::string precision = "float";
     uint32_t spp = 1;
     uint32_t orderCheck = 0;
+    std::string aov;
 };
 
-
-void writeOutput(const std::string& path, const Image& image) {
-    const auto parent = std::filesystem::path(path).parent_path();
-    if (!parent.empty()) std::filesystem::create_directories(parent);
-    writeImage(path, image);
+// --aov: the index map with its legend beside it; the legend also goes to stdout.
+void renderIndexMap(scenes::Scene& scene, const scenes::RenderSettings& settings, const RenderOptions& o) {
+    const std::optional<scenes::IndexMapKind> kind = scenes::parseIndexMapKind(o.aov);
+    REFRAY_CHECK(kind, "--aov expects one of " << joined(scenes::indexMapKindNames()) << ", got '" << o.aov << "'"
+                                               << didYouMean(o.aov, scenes::indexMapKindNames()));
+    REFRAY_CHECK(o.orderCheck == 0, "--aov and --order-check are separate renders; give one of them");
+    const scenes::IndexMap map = scenes::renderIndexMap(scene, settings, *kind);
+    const std::string title = scene.desc().name + ": " + o.aov + " of each pixel's primary ray";
+    bool drewText = true;
+    Image image = scenes::withLegend(map, title, &drewText);
+    image.metadata["refray_version"] = tools::kVersion;
+    image.metadata["refray_commit"] = tools::kCommit;
+    writeOutput(o.output, image);
+    std::printf("%s\n", title.c_str());
+    for (const scenes::IndexMapEntry& e : map.legend)
+        std::printf("  #%02X%02X%02X  %6.2f%%  %s\n", floatToUnorm8(e.colour.r), floatToUnorm8(e.colour.g),
+                    floatToUnorm8(e.colour.b), 100.0 * double(e.pixels) / double(map.values.size()), e.label.c_str());
+    if (!drewText) std::fprintf(stderr, "refray: no font found (install fonts-dejavu-core): the legend is only printed above\n");
+    std::printf("wrote %s\n", o.output.c_str());
 }
+
 
 int runRender(const RenderOptions& o) {
     scenes::RenderSettings settings;
@@ -100,9 +101,9 @@ int runRender(const RenderOptions& o) {
 
     scenes::RenderResult result;
     if (o.scene == "builtin") {
-        REFRAY_CHECK(o.camera.empty() && !o.time && o.spp == 1 && o.precision == "float" && o.orderCheck == 0,
+        REFRAY_CHECK(o.camera.empty() && !o.time && o.spp == 1 && o.precision == "float" && o.orderCheck == 0 && o.aov.empty(),
                      "the built-in scene has one camera, no time, one sample per pixel and float shaders; "
-                     "--camera, --time, --spp, --precision and --order-check are for scene files");
+                     "--camera, --time, --spp, --precision, --order-check and --aov are for scene files");
         const Size size = parseSize(o.size.empty() ? "640x360" : o.size);
         settings.width = size.width, settings.height = size.height;
         scenes::BuiltinScene scene;
@@ -114,6 +115,10 @@ int runRender(const RenderOptions& o) {
         std::unique_ptr<scenes::Scene> scene = scenes::loadScene(o.scene);
         const Size size = o.size.empty() ? Size{scene->desc().defaultWidth, scene->desc().defaultHeight} : parseSize(o.size);
         settings.width = size.width, settings.height = size.height;
+        if (!o.aov.empty()) {
+            renderIndexMap(*scene, settings, o);
+            return 0;
+        }
         if (o.orderCheck > 0) {
             scenes::OrderCheckResult check = scenes::checkTraversalOrder(*scene, settings, o.orderCheck);
             result = std::move(check.ordered);
@@ -165,12 +170,21 @@ int main(int argc, char** argv) {
     render->add_option("--order", ro.order, "Traversal order: ordered (default) or adversarial (GEN-3)");
     render->add_option("--seed", ro.seed, "Seed of the adversarial order");
     render->add_flag("--stats", ro.stats, "Print rays, invocations and timing");
+    render->add_option("--aov", ro.aov,
+                       "Write an index map instead of the render: record|instance|geometry|primitive|hitgroup|depth "
+                       "of each pixel's primary ray, false-coloured, with a legend");
     render->add_option("--order-check", ro.orderCheck,
                        "Also render N seeded adversarial traversal orders (GEN-3) and write OUTPUT.order-mask.png: "
                        "white where a pixel depends on the order");
 
     refray::tools::CompareCommandOptions compareOptions;
     CLI::App* compare = refray::tools::addCompareCommand(app, compareOptions);
+
+    refray::tools::TableCommandOptions tableOptions;
+    CLI::App* table = refray::tools::addTableCommand(app, tableOptions);
+
+    refray::tools::ExplainCommandOptions explainOptions;
+    CLI::App* explain = refray::tools::addExplainCommand(app, explainOptions);
 
     auto* golden = app.add_subcommand("golden", "Golden images of every scene x camera (tests/golden/)");
     golden->require_subcommand(1);
@@ -187,6 +201,8 @@ int main(int argc, char** argv) {
         app.parse(argc, argv);
         if (*render) return runRender(ro);
         if (*compare) return refray::tools::runCompare(compareOptions);
+        if (*table) return refray::tools::runTable(tableOptions);
+        if (*explain) return refray::tools::runExplain(explainOptions);
         if (*update) {
             const Size size = parseSize(goldenSize);
             scenes::GoldenUpdateOptions options;

@@ -9,6 +9,7 @@ packages=(
   googletest libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libtinyobjloader-dev
   chromium  # the compare tool's HTML report is checked in headless Chromium
+  fonts-dejavu-core  # legends of index maps (refray render --aov) are drawn with DejaVu Sans
 )
 
 missing=()

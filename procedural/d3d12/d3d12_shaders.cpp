@@ -238,58 +238,68 @@ math::RayExtent<T> CurrentExtent(const ShaderContext& ctx) {
 
 // TraceRay wrappers: both stop at MAX_RAY_RECURSION_DEPTH (black / "not in shadow"); TMin 0, TMax 10000.
 // The RayDesc and the payload are the GPU interface: the ray is rounded to float on the way in.
+// PORT: the HLSL passes the constants TraceRayParameters::InstanceMask, TraceRayParameters::HitGroup::Offset[rayType],
+// TraceRayParameters::HitGroup::GeometryStride and TraceRayParameters::MissShader::Offset[rayType]; here they come
+// from `traceRay` (the library's TraceRayArgumentSet, those same values by default), which every caller passes down.
 template <typename T>
-tvec4<T> TraceRadianceRay(ShaderContext& ctx, const tvec3<T>& origin, const tvec3<T>& direction,
-                          uint32_t currentRayRecursionDepth) {
+tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const tvec3<T>& origin,
+                          const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
     if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH) return tvec4<T>(T(0));
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     RayPayload rayPayload{vec4(0.0f), currentRayRecursionDepth + 1};
+    const TraceRayArguments& radiance = traceRay[RayType::Radiance];
     ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_CULL_BACK_FACING_TRIANGLES,
-                 TraceRayParameters::InstanceMask, /*HitGroup::Offset*/ RayType::Radiance,
-                 TraceRayParameters::GeometryStride, /*MissShader::Offset*/ RayType::Radiance, rayDesc, rayPayload);
+                 radiance.instanceInclusionMask, /*HitGroup::Offset*/ radiance.rayContribution,
+                 /*HitGroup::GeometryStride*/ radiance.multiplier, /*MissShader::Offset*/ radiance.missShaderIndex,
+                 rayDesc, rayPayload);
     return tvec4<T>(rayPayload.color);
 }
 
 template <typename T>
-bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const tvec3<T>& origin, const tvec3<T>& direction,
-                                  uint32_t currentRayRecursionDepth) {
+bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const tvec3<T>& origin,
+                                  const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
     if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH) return false;
     // TMax 10000, not the distance to the light (I2).
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     // Starts as "hit": closest-hit and any-hit shaders are skipped, only MyMissShader_ShadowRay clears it.
     ShadowRayPayload shadowPayload{1};
+    const TraceRayArguments& shadow = traceRay[RayType::Shadow];
     ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure),
                  RAY_FLAG_CULL_BACK_FACING_TRIANGLES | RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_FORCE_OPAQUE |
                      RAY_FLAG_SKIP_CLOSEST_HIT_SHADER,
-                 TraceRayParameters::InstanceMask, /*HitGroup::Offset*/ RayType::Shadow,
-                 TraceRayParameters::GeometryStride, /*MissShader::Offset*/ RayType::Shadow, rayDesc, shadowPayload);
+                 shadow.instanceInclusionMask, /*HitGroup::Offset*/ shadow.rayContribution,
+                 /*HitGroup::GeometryStride*/ shadow.multiplier, /*MissShader::Offset*/ shadow.missShaderIndex, rayDesc,
+                 shadowPayload);
     return shadowPayload.hit != 0;
 }
 
 // The shadow ray both closest hits start with: from HitWorldPosition() towards the light.
 template <typename T>
-bool TraceShadowRayTowardsLight(ShaderContext& ctx, const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth) {
+bool TraceShadowRayTowardsLight(ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
+                                const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth) {
     const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
-    return TraceShadowRayAndReportIfHit(
-        ctx, hitPosition, hlsl::normalize(tvec3<T>(vec3(g_sceneCB.lightPosition)) - hitPosition), recursionDepth);
+    return TraceShadowRayAndReportIfHit(ctx, traceRay, hitPosition,
+                                        hlsl::normalize(tvec3<T>(vec3(g_sceneCB.lightPosition)) - hitPosition),
+                                        recursionDepth);
 }
 
 // reflectanceCoef·(Fresnel, 1)·(reflection ray colour), the reflection ray leaving HitWorldPosition().
 template <typename T>
-tvec4<T> ReflectedColor(ShaderContext& ctx, const tvec3<T>& normal, const PrimitiveConstantBuffer& l_materialCB,
-                        uint32_t recursionDepth) {
+tvec4<T> ReflectedColor(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const tvec3<T>& normal,
+                        const PrimitiveConstantBuffer& l_materialCB, uint32_t recursionDepth) {
     const tvec3<T> D = tvec3<T>(ctx.WorldRayDirection());
     const tvec4<T> reflectionColor =
-        TraceRadianceRay(ctx, HitWorldPosition<T>(ctx), hlsl::reflect(D, normal), recursionDepth);
+        TraceRadianceRay(ctx, traceRay, HitWorldPosition<T>(ctx), hlsl::reflect(D, normal), recursionDepth);
     const tvec3<T> fresnelR = FresnelReflectanceSchlick(D, normal, tvec3<T>(vec3(l_materialCB.albedo)));
     return T(l_materialCB.reflectanceCoef) * tvec4<T>(fresnelR, T(1)) * reflectionColor;
 }
 
 // ---- Entry points ----------------------------------------------------------------------------------
-// Each is a template on the scalar type; results are rounded to float where they cross the interface.
+// Each is a template on the scalar type; results are rounded to float where they cross the interface. Those that
+// trace rays take the library's TraceRay arguments (PORT: constants in the HLSL).
 
 template <typename T>
-void MyRaygenShader(ShaderContext& ctx) {
+void MyRaygenShader(ShaderContext& ctx, const TraceRayArgumentSet& traceRay) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const uvec3 index = ctx.DispatchRaysIndex();
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
@@ -297,14 +307,14 @@ void MyRaygenShader(ShaderContext& ctx) {
     GenerateCameraRay(uvec2(index), uvec2(ctx.DispatchRaysDimensions()), tvec3<T>(vec3(g_sceneCB.cameraPosition)),
                       g_sceneCB.projectionToWorld, origin, direction);
     const uint32_t currentRecursionDepth = 0;
-    const tvec4<T> color = TraceRadianceRay(ctx, origin, direction, currentRecursionDepth);
+    const tvec4<T> color = TraceRadianceRay(ctx, traceRay, origin, direction, currentRecursionDepth);
     // PORT: the texture stores floats; the R8G8B8A8_UNORM conversion (clamp, round, NaN -> 0) happens when the
     // image is written out (H20).
     ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView)).at(index.x, index.y) = vec4(color);
 }
 
 template <typename T>
-void MyClosestHitShader_Triangle(ShaderContext& ctx, RayPayload& rayPayload,
+void MyClosestHitShader_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, RayPayload& rayPayload,
                                  const BuiltInTriangleIntersectionAttributes&) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
@@ -323,7 +333,7 @@ void MyClosestHitShader_Triangle(ShaderContext& ctx, RayPayload& rayPayload,
         ctx.loadFromTable<Vertex>(vertexBuffers, /*g_vertices*/ 1, uint64_t(indices[0]) * sizeof(Vertex)).normal);
 
     // Shadow component.
-    const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, g_sceneCB, rayPayload.recursionDepth);
+    const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, traceRay, g_sceneCB, rayPayload.recursionDepth);
 
     // Grid lines from the primary camera rays' footprint, even for secondary hits (I7, H4).
     const T checkers = AnalyticalCheckersTexture(
@@ -333,7 +343,7 @@ void MyClosestHitShader_Triangle(ShaderContext& ctx, RayPayload& rayPayload,
     // Reflected component.
     tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, triangleNormal, l_materialCB, rayPayload.recursionDepth);
+        reflectedColor = ReflectedColor(ctx, traceRay, triangleNormal, l_materialCB, rayPayload.recursionDepth);
 
     // Final colour, then the visibility falloff.
     const tvec4<T> phongColor = CalculatePhongLighting(
@@ -345,17 +355,18 @@ void MyClosestHitShader_Triangle(ShaderContext& ctx, RayPayload& rayPayload,
 }
 
 template <typename T>
-void MyClosestHitShader_AABB(ShaderContext& ctx, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
+void MyClosestHitShader_AABB(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, RayPayload& rayPayload,
+                             const ProceduralPrimitiveAttributes& attr) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
     const tvec3<T> normal = tvec3<T>(attr.normal);
 
-    const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, g_sceneCB, rayPayload.recursionDepth);
+    const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, traceRay, g_sceneCB, rayPayload.recursionDepth);
 
     tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, normal, l_materialCB, rayPayload.recursionDepth);
+        reflectedColor = ReflectedColor(ctx, traceRay, normal, l_materialCB, rayPayload.recursionDepth);
 
     const tvec4<T> phongColor = CalculatePhongLighting(
         g_sceneCB, tvec4<T>(l_materialCB.albedo), normal, shadowRayHit, T(l_materialCB.diffuseCoef),
@@ -431,19 +442,20 @@ void MyIntersectionShader_SignedDistancePrimitive(ShaderContext& ctx) {
     }
 }
 
-// Every export, with its math in T.
+// Every export, with its math in T. The lambdas hold a copy of the TraceRay arguments, which the shaders that
+// trace rays take by reference.
 template <typename T>
-void addExports(ShaderLibrary& lib) {
-    lib.addRayGeneration("MyRaygenShader", [](ShaderContext& ctx) { MyRaygenShader<T>(ctx); });
+void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay) {
+    lib.addRayGeneration("MyRaygenShader", [traceRay](ShaderContext& ctx) { MyRaygenShader<T>(ctx, traceRay); });
     lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
         "MyClosestHitShader_Triangle",
-        [](ShaderContext& ctx, RayPayload& payload, const BuiltInTriangleIntersectionAttributes& attr) {
-            MyClosestHitShader_Triangle<T>(ctx, payload, attr);
+        [traceRay](ShaderContext& ctx, RayPayload& payload, const BuiltInTriangleIntersectionAttributes& attr) {
+            MyClosestHitShader_Triangle<T>(ctx, traceRay, payload, attr);
         });
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "MyClosestHitShader_AABB",
-        [](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
-            MyClosestHitShader_AABB<T>(ctx, payload, attr);
+        [traceRay](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
+            MyClosestHitShader_AABB<T>(ctx, traceRay, payload, attr);
         });
     lib.addMiss<RayPayload>("MyMissShader", MyMissShader);
     lib.addMiss<ShadowRayPayload>("MyMissShader_ShadowRay", MyMissShader_ShadowRay);
@@ -460,10 +472,10 @@ void addExports(ShaderLibrary& lib) {
 
 }  // namespace
 
-std::shared_ptr<ShaderLibrary> makeD3D12ShaderLibrary(Precision precision) {
+std::shared_ptr<ShaderLibrary> makeD3D12ShaderLibrary(Precision precision, const TraceRayArgumentSet& traceRay) {
     auto lib = std::make_shared<ShaderLibrary>();
-    if (precision == Precision::Double) addExports<double>(*lib);
-    else addExports<float>(*lib);
+    if (precision == Precision::Double) addExports<double>(*lib, traceRay);
+    else addExports<float>(*lib, traceRay);
     return lib;
 }
 

@@ -26,6 +26,7 @@
 #include "procedural/sample_layout.h"
 #include "procedural/math/fractals.h"
 #include "procedural/precision.h"
+#include "procedural/trace_ray_parameters.h"
 
 namespace refray::procedural::d3d12 {
 
@@ -119,6 +120,17 @@ inline constexpr uint32_t InstanceMask = ~0u;
 inline constexpr uint32_t GeometryStride = RayType::Count;
 }  // namespace TraceRayParameters
 
+static_assert(RayType::Count == kTraceRayTypeCount);
+// What TraceRadianceRay and TraceShadowRayAndReportIfHit pass to TraceRay in the HLSL, per ray type.
+constexpr TraceRayArgumentSet defaultTraceRayArguments() {
+    TraceRayArgumentSet traceRay;
+    traceRay[RayType::Radiance] = {RayType::Radiance, TraceRayParameters::GeometryStride, RayType::Radiance,
+                                   TraceRayParameters::InstanceMask};
+    traceRay[RayType::Shadow] = {RayType::Shadow, TraceRayParameters::GeometryStride, RayType::Shadow,
+                                 TraceRayParameters::InstanceMask};
+    return traceRay;
+}
+
 // primitiveType per intersection shader.
 namespace AnalyticPrimitive {
 enum Enum : uint32_t { AABB = 0, Spheres = 1, Count = 2 };
@@ -163,7 +175,10 @@ std::vector<std::string> aabbHitGroupNames();
 // MyMissShader_ShadowRay, MyIntersectionShader_AnalyticPrimitive, MyIntersectionShader_VolumetricPrimitive,
 // MyIntersectionShader_SignedDistancePrimitive.
 // PORT: `precision` selects the scalar type of the shader-internal math (Precision::Double is not the GPU's).
-std::shared_ptr<dxr::ShaderLibrary> makeD3D12ShaderLibrary(Precision precision = Precision::Float);
+// PORT: `traceRay` holds the TraceRay arguments the HLSL compiles in as constants, per ray type; the default is the
+// HLSL's. Other values reproduce the shaders compiled with other constants (IDX-1, IDX-7).
+std::shared_ptr<dxr::ShaderLibrary> makeD3D12ShaderLibrary(
+    Precision precision = Precision::Float, const TraceRayArgumentSet& traceRay = defaultTraceRayArguments());
 
 // ---- The ground plane's index and vertex buffers (§1.2) ----------------------------------------------
 // What the app uploads as g_indices (6 16-bit indices, a raw view) and g_vertices (4 vertices, stride 24), which

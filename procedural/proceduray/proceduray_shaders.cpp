@@ -222,48 +222,56 @@ tvec4<T> CalculatePhongLighting(const ShaderContext& ctx, const SceneConstantBuf
 
 // TraceRay wrappers: both stop at MAX_RAY_RECURSION_DEPTH (black / "not in shadow"); TMin 0, TMax 10000.
 // The RayDesc and the payload are the GPU interface: the ray is rounded to float on the way in.
+// PORT: the HLSL passes the constants kInstanceMask, <ray type>, RayTypeCount, <ray type>; here they come from
+// `traceRay` (the library's TraceRayArgumentSet, those same values by default), which every caller passes down.
 template <typename T>
-tvec4<T> TraceRadianceRay(ShaderContext& ctx, const tvec3<T>& origin, const tvec3<T>& direction,
-                          uint32_t currentRayRecursionDepth) {
+tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const tvec3<T>& origin,
+                          const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
     if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH) return tvec4<T>(T(0));
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     RayPayload rayPayload{vec4(0.0f), currentRayRecursionDepth + 1, 0.0f, 0, 0};
-    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_CULL_BACK_FACING_TRIANGLES, kInstanceMask,
-                 /*RayContributionToHitGroupIndex*/ Radiance, /*MultiplierForGeometryContribution*/ RayTypeCount,
-                 /*MissShaderIndex*/ Radiance, rayDesc, rayPayload);
+    const TraceRayArguments& radiance = traceRay[Radiance];
+    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_CULL_BACK_FACING_TRIANGLES,
+                 radiance.instanceInclusionMask, /*RayContributionToHitGroupIndex*/ radiance.rayContribution,
+                 /*MultiplierForGeometryContribution*/ radiance.multiplier,
+                 /*MissShaderIndex*/ radiance.missShaderIndex, rayDesc, rayPayload);
     return tvec4<T>(rayPayload.color);
 }
 
 template <typename T>
-bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const tvec3<T>& origin, const tvec3<T>& direction,
-                                  uint32_t currentRayRecursionDepth) {
+bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const tvec3<T>& origin,
+                                  const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
     if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH) return false;
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     // Starts as "hit": closest-hit and any-hit shaders are skipped, only Miss_Shadow clears it.
     ShadowRayPayload shadowPayload{0.0f, 1};
+    const TraceRayArguments& shadow = traceRay[Shadow];
     ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure),
                  RAY_FLAG_CULL_BACK_FACING_TRIANGLES | RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_FORCE_OPAQUE |
                      RAY_FLAG_SKIP_CLOSEST_HIT_SHADER,
-                 kInstanceMask, /*RayContributionToHitGroupIndex*/ Shadow,
-                 /*MultiplierForGeometryContribution*/ RayTypeCount, /*MissShaderIndex*/ Shadow, rayDesc, shadowPayload);
+                 shadow.instanceInclusionMask, /*RayContributionToHitGroupIndex*/ shadow.rayContribution,
+                 /*MultiplierForGeometryContribution*/ shadow.multiplier, /*MissShaderIndex*/ shadow.missShaderIndex,
+                 rayDesc, shadowPayload);
     return shadowPayload.hit != 0;
 }
 
 // The shadow test every lit closest hit starts with: from HitWorldPosition() towards the light.
 template <typename T>
-bool TraceShadowRayTowardsLight(ShaderContext& ctx, const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth) {
+bool TraceShadowRayTowardsLight(ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
+                                const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth) {
     const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
-    return TraceShadowRayAndReportIfHit(
-        ctx, hitPosition, hlsl::normalize(tvec3<T>(g_sceneCB.lightPosition) - hitPosition), recursionDepth);
+    return TraceShadowRayAndReportIfHit(ctx, traceRay, hitPosition,
+                                        hlsl::normalize(tvec3<T>(g_sceneCB.lightPosition) - hitPosition),
+                                        recursionDepth);
 }
 
 // reflectanceCoef·(Fresnel, 1)·(reflection ray colour), the reflection ray leaving HitWorldPosition().
 template <typename T>
-tvec4<T> ReflectedColor(ShaderContext& ctx, const tvec3<T>& normal, T reflectanceCoef, const tvec3<T>& f0,
-                        uint32_t recursionDepth) {
+tvec4<T> ReflectedColor(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const tvec3<T>& normal,
+                        T reflectanceCoef, const tvec3<T>& f0, uint32_t recursionDepth) {
     const tvec3<T> D = tvec3<T>(ctx.WorldRayDirection());
     const tvec4<T> reflectionColor =
-        TraceRadianceRay(ctx, HitWorldPosition<T>(ctx), hlsl::reflect(D, normal), recursionDepth);
+        TraceRadianceRay(ctx, traceRay, HitWorldPosition<T>(ctx), hlsl::reflect(D, normal), recursionDepth);
     const tvec3<T> fresnelR = FresnelReflectanceSchlick(D, normal, f0);
     return reflectanceCoef * tvec4<T>(fresnelR, T(1)) * reflectionColor;
 }
@@ -282,10 +290,11 @@ T GetDistanceFromSignedDistancePrimitive(const tvec3<T>& position, SignedDistanc
 constexpr ProceduralPrimitiveAttributes kInitialAttributes{vec3(0.0f), vec4(0.0f, 0.0f, 0.0f, 1.0f)};
 
 // ---- Entry points ----------------------------------------------------------------------------------
-// Each is a template on the scalar type; results are rounded to float where they cross the interface.
+// Each is a template on the scalar type; results are rounded to float where they cross the interface. Those that
+// trace rays take the library's TraceRay arguments (PORT: constants in the HLSL).
 
 template <typename T>
-void Raygen(ShaderContext& ctx) {
+void Raygen(ShaderContext& ctx, const TraceRayArgumentSet& traceRay) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const uvec3 index = ctx.DispatchRaysIndex();
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
@@ -293,7 +302,7 @@ void Raygen(ShaderContext& ctx) {
     GenerateCameraRay(uvec2(index), uvec2(ctx.DispatchRaysDimensions()), tvec3<T>(g_sceneCB.cameraPosition),
                       g_sceneCB.projectionToWorld, origin, direction);
     const uint32_t currentRecursionDepth = 0;
-    const tvec4<T> color = TraceRadianceRay(ctx, origin, direction, currentRecursionDepth);
+    const tvec4<T> color = TraceRadianceRay(ctx, traceRay, origin, direction, currentRecursionDepth);
     // PORT: the texture stores floats; the R8G8B8A8_UNORM conversion happens when the image is written out.
     ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView)).at(index.x, index.y) = vec4(color);
 }
@@ -310,7 +319,8 @@ void Miss_Shadow(ShaderContext&, ShadowRayPayload& rayPayload) {
 }
 
 template <typename T>
-void ClosestHit_Triangle(ShaderContext& ctx, RayPayload& rayPayload, const BuiltInTriangleIntersectionAttributes&) {
+void ClosestHit_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, RayPayload& rayPayload,
+                         const BuiltInTriangleIntersectionAttributes&) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     if (g_sceneCB.debugFlag) {
@@ -333,13 +343,13 @@ void ClosestHit_Triangle(ShaderContext& ctx, RayPayload& rayPayload, const Built
         ctx.loadFromTable<Vertex>(vertexBuffers, /*g_vertices*/ 1, uint64_t(indices[0]) * sizeof(Vertex)).normal;
     const tvec3<T> triangleNormal = -tvec3<T>(storedNormal);
 
-    const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, g_sceneCB, rayPayload.recursionDepth);
+    const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, traceRay, g_sceneCB, rayPayload.recursionDepth);
 
     const tvec4<T> albedo = tvec4<T>(l_materialCB.albedo);
     tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, triangleNormal, T(l_materialCB.reflectanceCoef), tvec3<T>(albedo),
-                                        rayPayload.recursionDepth);
+        reflectedColor = ReflectedColor(ctx, traceRay, triangleNormal, T(l_materialCB.reflectanceCoef),
+                                        tvec3<T>(albedo), rayPayload.recursionDepth);
 
     const tvec4<T> phongColor =
         CalculatePhongLighting(ctx, g_sceneCB, albedo, triangleNormal, shadowRayHit, T(l_materialCB.diffuseCoef),
@@ -381,7 +391,8 @@ void Intersection_Pacman(ShaderContext& ctx) {
 }
 
 template <typename T>
-void ClosestHit_Pacman(ShaderContext& ctx, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
+void ClosestHit_Pacman(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, RayPayload& rayPayload,
+                       const ProceduralPrimitiveAttributes& attr) {
     [[maybe_unused]] PrecisionScope<T> scope;
     if (ctx.HitKind() == 1) {
         rayPayload.color = vec4(0.0f, 0.0f, 1.0f, 0.0f);
@@ -392,11 +403,11 @@ void ClosestHit_Pacman(ShaderContext& ctx, RayPayload& rayPayload, const Procedu
     const tvec3<T> normal = tvec3<T>(attr.normal);
     const tvec4<T> albedo = tvec4<T>(l_materialCB.albedo);
 
-    const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, g_sceneCB, rayPayload.recursionDepth);
+    const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, traceRay, g_sceneCB, rayPayload.recursionDepth);
 
     tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, normal, T(l_materialCB.reflectanceCoef), tvec3<T>(albedo),
+        reflectedColor = ReflectedColor(ctx, traceRay, normal, T(l_materialCB.reflectanceCoef), tvec3<T>(albedo),
                                         rayPayload.recursionDepth);
 
     const tvec4<T> phongColor =
@@ -435,7 +446,8 @@ void Intersection_Mandelbulb(ShaderContext& ctx) {
 }
 
 template <typename T>
-void ClosestHit_Mandelbulb(ShaderContext& ctx, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
+void ClosestHit_Mandelbulb(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, RayPayload& rayPayload,
+                           const ProceduralPrimitiveAttributes& attr) {
     [[maybe_unused]] PrecisionScope<T> scope;
     if (ctx.HitKind() == 1) {
         rayPayload.color = vec4(0.0f, 1.0f, 0.0f, 0.0f);
@@ -448,7 +460,7 @@ void ClosestHit_Mandelbulb(ShaderContext& ctx, RayPayload& rayPayload, const Pro
 
     tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, normal, T(l_materialCB.reflectanceCoef),
+        reflectedColor = ReflectedColor(ctx, traceRay, normal, T(l_materialCB.reflectanceCoef),
                                         tvec3<T>(vec3(l_materialCB.albedo)), rayPayload.recursionDepth);
 
     color = color + reflectedColor;
@@ -482,7 +494,8 @@ void Intersection_Julia(ShaderContext& ctx) {
 }
 
 template <typename T>
-void ClosestHit_Julia(ShaderContext& ctx, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
+void ClosestHit_Julia(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, RayPayload& rayPayload,
+                      const ProceduralPrimitiveAttributes& attr) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     if (g_sceneCB.debugFlag) {
@@ -503,7 +516,8 @@ void ClosestHit_Julia(ShaderContext& ctx, RayPayload& rayPayload, const Procedur
     const T reflecCoef = T(0.1f);
     tvec4<T> reflectedColor(T(0));
     if (reflecCoef > T(0.001f))
-        reflectedColor = ReflectedColor(ctx, normal, reflecCoef, tvec3<T>(albedo), rayPayload.recursionDepth);
+        reflectedColor =
+            ReflectedColor(ctx, traceRay, normal, reflecCoef, tvec3<T>(albedo), rayPayload.recursionDepth);
 
     const T diffuseCoef = T(0.6f);
     const T specularCoef = T(0.08f);
@@ -515,44 +529,47 @@ void ClosestHit_Julia(ShaderContext& ctx, RayPayload& rayPayload, const Procedur
     rayPayload.color = vec4(color);
 }
 
-// Every export, with its math in T.
+// Every export, with its math in T. The lambdas hold a copy of the TraceRay arguments, which the shaders that
+// trace rays take by reference.
 template <typename T>
-void addExports(ShaderLibrary& lib) {
-    lib.addRayGeneration("Raygen", [](ShaderContext& ctx) { Raygen<T>(ctx); });
+void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay) {
+    lib.addRayGeneration("Raygen", [traceRay](ShaderContext& ctx) { Raygen<T>(ctx, traceRay); });
     lib.addMiss<RayPayload>("Miss", Miss);
     lib.addMiss<ShadowRayPayload>("Miss_Shadow", Miss_Shadow);
     lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
         "ClosestHit_Triangle",
-        [](ShaderContext& ctx, RayPayload& payload, const BuiltInTriangleIntersectionAttributes& attr) {
-            ClosestHit_Triangle<T>(ctx, payload, attr);
+        [traceRay](ShaderContext& ctx, RayPayload& payload, const BuiltInTriangleIntersectionAttributes& attr) {
+            ClosestHit_Triangle<T>(ctx, traceRay, payload, attr);
         });
     lib.addIntersection<ProceduralPrimitiveAttributes>("Intersection_Julia",
                                                        [](ShaderContext& ctx) { Intersection_Julia<T>(ctx); });
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
-        "ClosestHit_Julia", [](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
-            ClosestHit_Julia<T>(ctx, payload, attr);
+        "ClosestHit_Julia",
+        [traceRay](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
+            ClosestHit_Julia<T>(ctx, traceRay, payload, attr);
         });
     lib.addIntersection<ProceduralPrimitiveAttributes>("Intersection_Pacman",
                                                        [](ShaderContext& ctx) { Intersection_Pacman<T>(ctx); });
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
-        "ClosestHit_Pacman", [](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
-            ClosestHit_Pacman<T>(ctx, payload, attr);
+        "ClosestHit_Pacman",
+        [traceRay](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
+            ClosestHit_Pacman<T>(ctx, traceRay, payload, attr);
         });
     lib.addIntersection<ProceduralPrimitiveAttributes>("Intersection_Mandelbulb",
                                                        [](ShaderContext& ctx) { Intersection_Mandelbulb<T>(ctx); });
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Mandelbulb",
-        [](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
-            ClosestHit_Mandelbulb<T>(ctx, payload, attr);
+        [traceRay](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
+            ClosestHit_Mandelbulb<T>(ctx, traceRay, payload, attr);
         });
 }
 
 }  // namespace
 
-std::shared_ptr<ShaderLibrary> makeProcedurayShaderLibrary(Precision precision) {
+std::shared_ptr<ShaderLibrary> makeProcedurayShaderLibrary(Precision precision, const TraceRayArgumentSet& traceRay) {
     auto lib = std::make_shared<ShaderLibrary>();
-    if (precision == Precision::Double) addExports<double>(*lib);
-    else addExports<float>(*lib);
+    if (precision == Precision::Double) addExports<double>(*lib, traceRay);
+    else addExports<float>(*lib, traceRay);
     return lib;
 }
 

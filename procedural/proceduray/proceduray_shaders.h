@@ -24,6 +24,7 @@
 #include "emulator/state_object.h"
 #include "procedural/sample_layout.h"
 #include "procedural/precision.h"
+#include "procedural/trace_ray_parameters.h"
 
 namespace refray::procedural::proceduray {
 
@@ -109,6 +110,14 @@ enum RayType : uint32_t { Radiance = 0, Shadow = 1, RayTypeCount = 2 };
 // TraceRayParameters: InstanceMask = ~0 (only the low 8 bits count), hit-group offset = ray type,
 // geometry stride = ray type count, miss offset = ray type.
 inline constexpr uint32_t kInstanceMask = ~0u;
+static_assert(RayTypeCount == kTraceRayTypeCount);
+// What TraceRadianceRay and TraceShadowRayAndReportIfHit pass to TraceRay in the HLSL, per ray type.
+constexpr TraceRayArgumentSet defaultTraceRayArguments() {
+    TraceRayArgumentSet traceRay;
+    traceRay[Radiance] = {Radiance, RayTypeCount, Radiance, kInstanceMask};
+    traceRay[Shadow] = {Shadow, RayTypeCount, Shadow, kInstanceMask};
+    return traceRay;
+}
 inline constexpr vec4 kBackgroundColor{0.6f, 0.7f, 0.9f, 1.0f};
 inline constexpr float kInShadowRadiance = 0.35f;
 
@@ -142,7 +151,10 @@ std::vector<dxr::HitGroupDesc> procedurayHitGroups();
 // Exports, with their HLSL names: Raygen, Miss, Miss_Shadow, ClosestHit_Triangle, Intersection_Julia,
 // ClosestHit_Julia, Intersection_Pacman, ClosestHit_Pacman, Intersection_Mandelbulb, ClosestHit_Mandelbulb.
 // PORT: `precision` selects the scalar type of the shader-internal math (Precision::Double is not the GPU's).
-std::shared_ptr<dxr::ShaderLibrary> makeProcedurayShaderLibrary(Precision precision = Precision::Float);
+// PORT: `traceRay` holds the TraceRay arguments the HLSL compiles in as constants, per ray type; the default is the
+// HLSL's. Other values reproduce the shaders compiled with other constants (IDX-1, IDX-7).
+std::shared_ptr<dxr::ShaderLibrary> makeProcedurayShaderLibrary(
+    Precision precision = Precision::Float, const TraceRayArgumentSet& traceRay = defaultTraceRayArguments());
 
 // ---- The slab's index and vertex buffers (§1.1) ----------------------------------------------------
 // What the scene uploads as g_indices (36 16-bit indices = 18 dwords, a raw view) and g_vertices (8 vertices,

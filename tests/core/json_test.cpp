@@ -390,3 +390,37 @@ TEST(Json, ParseFileNamesTheFileInLocations) {
     EXPECT_EQ(at(v.find("a")->location()), path.string() + ":1:7");
     std::filesystem::remove(path);
 }
+
+TEST(Json, PatchReplacesAddsAndRemoves) {
+    Value doc = parse(R"({"instances": [{"name": "a", "mask": 1}, {"name": "b"}], "x~/y": 2, "drop": true})", "base.json");
+    const Value patch = parse(R"([
+  {"op": "replace", "path": "/instances/0/mask", "value": 0},
+  {"op": "add", "path": "/instances/1/mask", "value": 7},
+  {"op": "add", "path": "/instances/-", "value": {"name": "c"}},
+  {"op": "replace", "path": "/x~0~1y", "value": 3},
+  {"op": "remove", "path": "/drop"}
+])", "lesson.json");
+    applyPatch(doc, patch);
+    const auto& instances = doc.find("instances")->asArray();
+    ASSERT_EQ(instances.size(), 3u);
+    EXPECT_EQ(instances[0].find("mask")->asUint32(), 0u);
+    EXPECT_EQ(instances[1].find("mask")->asUint32(), 7u);
+    EXPECT_EQ(instances[2].find("name")->asString(), "c");
+    EXPECT_EQ(doc.find("x~/y")->asUint32(), 3u);
+    EXPECT_EQ(doc.find("drop"), nullptr);
+    // Patched values keep the patch's location; the rest keep the base's.
+    EXPECT_EQ(at(instances[0].find("mask")->location()), "lesson.json:2:59");
+    EXPECT_EQ(instances[0].find("name")->location().file, "base.json");
+}
+
+TEST(Json, PatchErrorsNameThePath) {
+    Value doc = parse(R"({"instances": [{"name": "a"}]})", "base.json");
+    EXPECT_EQ(errorOf([&] { applyPatch(doc, parse(R"([{"op": "replace", "path": "/instances/3/mask", "value": 0}])", "l.json")); }),
+              "l.json:1:28: path '/instances/3/mask': index 3 is past the end of an array of 1 elements");
+    EXPECT_EQ(errorOf([&] { applyPatch(doc, parse(R"([{"op": "replace", "path": "/instances/0/mask", "value": 0}])", "l.json")); }),
+              "l.json:1:28: path '/instances/0/mask': no member 'mask' to replace");
+    EXPECT_EQ(errorOf([&] { applyPatch(doc, parse(R"([{"op": "replce", "path": "/a", "value": 0}])", "l.json")); }),
+              "l.json:1:9: unknown patch op 'replce' (did you mean 'replace'?); expected replace, add or remove");
+    EXPECT_EQ(errorOf([&] { applyPatch(doc, parse(R"([{"op": "remove", "path": "instances"}])", "l.json")); }),
+              "l.json:1:27: a JSON Pointer starts with '/', got 'instances'");
+}

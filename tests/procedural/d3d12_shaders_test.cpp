@@ -12,12 +12,14 @@
 #include <map>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 #include <gtest/gtest.h>
 
 #include "emulator/device.h"
 #include "emulator/shader_api.h"
+#include "emulator/trace.h"
 
 namespace refray::procedural::d3d12 {
 namespace {
@@ -432,7 +434,7 @@ public:
     DispatchResult dispatch(const std::string& rayGen, bool useProbes, uint32_t width = 1, uint32_t height = 1) {
         StateObjectDesc desc;
         desc.name = "d3d12 test";
-        desc.libraries = {{makeD3D12ShaderLibrary(precision), {}}, {probes_, {}}};
+        desc.libraries = {{makeD3D12ShaderLibrary(precision, traceRay), {}}, {probes_, {}}};
         desc.hitGroups = d3d12HitGroups();
         std::vector<std::string> triangleGroups = triangleHitGroupNames();
         std::vector<std::string> aabbGroups = aabbHitGroupNames();
@@ -498,11 +500,14 @@ public:
         globals.setDescriptor(kVertexBuffers, heap.gpuHandle(1));
         DispatchOptions options;
         options.threads = 1;
+        options.observer = observer;
         return device.dispatchRays(rays, so, &globals, options);
     }
 
     Device device;
     Precision precision = Precision::Float;  // of the library under test
+    TraceRayArgumentSet traceRay = defaultTraceRayArguments();  // of the library under test
+    TraceObserver* observer = nullptr;                           // of the dispatch
     SceneConstantBuffer scene{};
     RayDesc probeRay;
     Probe probe;
@@ -557,6 +562,28 @@ private:
 void expectNear(vec3 got, vec3 expected, float tolerance, const char* what) {
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], expected[k], tolerance) << what << " component " << k;
 }
+
+// What the TraceRay calls of a dispatch passed, and the hit-group records they read (in program order: the rigs
+// dispatch on one thread).
+class TraceRayRecorder final : public TraceObserver {
+public:
+    struct Call {
+        uint32_t payloadSize = 0;
+        TraceRayArguments arguments;
+    };
+    struct Lookup {
+        HitGroupIndexTerms terms;
+        std::string hitGroup;
+    };
+    void onEvent(const TraceEvent& e) override {
+        if (e.kind == TraceEvent::Kind::TraceRay)
+            calls.push_back({e.payloadSize, {e.rayContribution, e.multiplier, e.missShaderIndex, e.instanceInclusionMask}});
+        else if (e.kind == TraceEvent::Kind::RecordLookup && e.hasTerms)
+            lookups.push_back({e.terms, std::string(e.exportName)});
+    }
+    std::vector<Call> calls;
+    std::vector<Lookup> lookups;
+};
 
 // ---- Intersection shaders through the probe hit groups ---------------------------------------------------
 
@@ -872,6 +899,56 @@ TEST(D3D12Shaders, WholeSceneRenderMissColourAndFiniteness) {
 }
 
 // ---- PORT tests ----------------------------------------------------------------------------------------
+
+// PORT (makeD3D12ShaderLibrary's traceRay): the shaders pass the library's TraceRay arguments, not the HLSL's
+// constants. The red box is geometry 1 of the AABB instance (C = 2), seen as in RedBoxShadedWithPhongAndFog: the
+// HLSL's radiance ray reads record R + M·G + C = 0 + 2·1 + 2 = 4. With R = 2, M = 0 it reads 2 + 0·1 + 2 = 4 too and
+// the shadow ray with R = 3, M = 0 reads record 5 like the HLSL's, so the pixel is unchanged while the trace shows
+// the arguments as passed, the mask's and miss index's unused high bits included (INST-4, IDX-7). A multiplier of 1
+// with two ray types sends the radiance ray to record 0 + 1·1 + 2 = 3: geometry 0's shadow hit group.
+TEST(D3D12Shaders, PORT_TraceRayArgumentsComeFromTheLibrary) {
+    D3D12Rig reference(false, {4, 0});
+    reference.setPointCamera(vec3(0.0f, 1.5f, -6.0f), vec3(1, 0, 0), vec3(0.0f), vec3(0.0f));
+    TraceRayRecorder defaults;
+    reference.observer = &defaults;
+    reference.dispatch("MyRaygenShader", false);
+    ASSERT_FALSE(defaults.lookups.empty());
+    EXPECT_EQ(defaults.lookups[0].terms.index, 4u);
+    EXPECT_EQ(defaults.lookups[0].terms.multiplier, 2u);
+
+    D3D12Rig rig(false, {4, 0});
+    rig.setPointCamera(vec3(0.0f, 1.5f, -6.0f), vec3(1, 0, 0), vec3(0.0f), vec3(0.0f));
+    rig.traceRay[RayType::Radiance] = {2, 0, 0x10000, 0xFFFFFF03};
+    rig.traceRay[RayType::Shadow] = {3, 0, 0x10001, 0x105};
+    TraceRayRecorder recorder;
+    rig.observer = &recorder;
+    const DispatchResult result = rig.dispatch("MyRaygenShader", false);
+    EXPECT_EQ(result.stats.raysTraced, 2u);  // primary and shadow (the red box does not reflect)
+    ASSERT_EQ(recorder.calls.size(), 2u);
+    EXPECT_EQ(recorder.calls[0].payloadSize, sizeof(RayPayload));
+    EXPECT_EQ(recorder.calls[0].arguments, rig.traceRay[RayType::Radiance]);
+    EXPECT_EQ(recorder.calls[1].payloadSize, sizeof(ShadowRayPayload));
+    EXPECT_EQ(recorder.calls[1].arguments, rig.traceRay[RayType::Shadow]);
+    ASSERT_FALSE(recorder.lookups.empty());
+    const HitGroupIndexTerms& primary = recorder.lookups[0].terms;
+    EXPECT_EQ(primary.rayContribution, 2u);
+    EXPECT_EQ(primary.multiplier, 0u);
+    EXPECT_EQ(primary.geometryIndex, 1u);
+    EXPECT_EQ(primary.instanceContribution, 2u);
+    EXPECT_EQ(primary.index, 4u);
+    EXPECT_EQ(recorder.lookups[0].hitGroup, "MyHitGroup_AABB_AnalyticPrimitive");
+    EXPECT_EQ(rig.output.at(0, 0), reference.output.at(0, 0));
+
+    D3D12Rig lesson(false, {4, 0});
+    lesson.setPointCamera(vec3(0.0f, 1.5f, -6.0f), vec3(1, 0, 0), vec3(0.0f), vec3(0.0f));
+    lesson.traceRay[RayType::Radiance].multiplier = 1;
+    TraceRayRecorder wrong;
+    lesson.observer = &wrong;
+    lesson.dispatch("MyRaygenShader", false);
+    ASSERT_FALSE(wrong.lookups.empty());
+    EXPECT_EQ(wrong.lookups[0].terms.index, 3u);
+    EXPECT_EQ(wrong.lookups[0].hitGroup, "MyHitGroup_AABB_SignedDistancePrimitive_ShadowRay");
+}
 
 // PORT (MyRaygenShader): the render target keeps the float colour; the R8G8B8A8_UNORM conversion happens only when
 // the image is written out (H20). The red box's shaded components are not multiples of 1/255.

@@ -9,11 +9,13 @@
 #include <cstddef>
 #include <map>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "emulator/device.h"
 #include "emulator/shader_api.h"
+#include "emulator/trace.h"
 #include "procedural/math/fractals.h"
 #include "procedural/math/sdf.h"
 
@@ -224,13 +226,15 @@ public:
     Image output{1, 1};
     Probe probe;
     Device device;
+    TraceRayArgumentSet traceRay = defaultTraceRayArguments();  // of the library under test
+    TraceObserver* observer = nullptr;                           // of the dispatch
 
     // Dispatches 1x1 with ray generation `rayGen` and the hit-group records [radiance, shadow] of
     // `hitGroup`; the radiance miss is `radianceMiss`.
     DispatchResult dispatch(const std::string& rayGen, const std::string& hitGroup, const std::string& radianceMiss) {
         StateObjectDesc desc;
         desc.name = "proceduray test";
-        desc.libraries = {{makeProcedurayShaderLibrary(), {}}, {probes_, {}}};
+        desc.libraries = {{makeProcedurayShaderLibrary(Precision::Float, traceRay), {}}, {probes_, {}}};
         desc.hitGroups = procedurayHitGroups();
         std::vector<std::string> procedural = {"HitGroup_Pacman",     "HitGroup_Pacman_Shadow", "HitGroup_Mandelbulb",
                                                "HitGroup_Mandelbulb_Shadow", "HitGroup_Julia", "HitGroup_Julia_Shadow"};
@@ -276,6 +280,7 @@ public:
         globals.setDescriptor(kVertexBuffers, heap_->gpuHandle(1));
         DispatchOptions options;
         options.threads = 1;
+        options.observer = observer;
         return device.dispatchRays(rays, so, &globals, options);
     }
 
@@ -524,6 +529,72 @@ TEST(ProcedurayShaders, PORT_RaygenStoresUnquantisedFloats) {
         const float quantised = std::round(std::clamp(got[c], 0.0f, 1.0f) * 255.0f) / 255.0f;
         EXPECT_GT(std::fabs(got[c] - quantised), 1e-5f) << "component " << c;
     }
+}
+
+// What the TraceRay calls of a dispatch passed, and the hit-group records they read (in program order: the rig
+// dispatches on one thread).
+class TraceRayRecorder final : public TraceObserver {
+public:
+    struct Call {
+        uint32_t payloadSize = 0;
+        TraceRayArguments arguments;
+    };
+    void onEvent(const TraceEvent& e) override {
+        if (e.kind == TraceEvent::Kind::TraceRay)
+            calls.push_back({e.payloadSize, {e.rayContribution, e.multiplier, e.missShaderIndex, e.instanceInclusionMask}});
+        else if (e.kind == TraceEvent::Kind::RecordLookup && e.hasTerms)
+            lookups.push_back(e.terms);
+    }
+    std::vector<Call> calls;
+    std::vector<HitGroupIndexTerms> lookups;
+};
+
+// Pac-man A's head seen through Raygen, as in RaygenShadesThePacmanHeadWithPhongAndReflection.
+vec4 renderPacmanHead(const TraceRayArgumentSet& traceRay, TraceRayRecorder* recorder = nullptr,
+                      DispatchResult* result = nullptr) {
+    ProcedurayRig rig = pacmanA();
+    rig.traceRay = traceRay;
+    rig.observer = recorder;
+    rig.scene.cameraPosition = vec4(35, -45, 50, 1);
+    rig.scene.projectionToWorld.m[3] = {35.0f, -45.0f, 40.0f, 1.0f};
+    const DispatchResult r = rig.dispatch("Raygen", "HitGroup_Pacman", "Miss");
+    if (result) *result = r;
+    return rig.output.at(0, 0);
+}
+
+// PORT (makeProcedurayShaderLibrary's traceRay): the shaders pass the library's TraceRay arguments, not the HLSL's
+// constants. R = 16 and M = 18 keep only their low 4 bits (0 and 2, IDX-2 warns), and the miss indices' and masks'
+// high bits do not count (IDX-7, INST-4), so the primary, shadow and reflection rays run the HLSL's records and
+// the pixel is unchanged, while the trace shows the arguments as passed. A radiance mask whose low 8 bits exclude
+// the instance (mask 1) makes the primary ray miss.
+TEST(ProcedurayShaders, PORT_TraceRayArgumentsComeFromTheLibrary) {
+    const vec4 reference = renderPacmanHead(defaultTraceRayArguments());
+
+    TraceRayArgumentSet traceRay;
+    traceRay[Radiance] = {16, 18, 0x10000, 0xFFFFFF01};
+    traceRay[Shadow] = {1, 3, 0x20001, 0x301};
+    TraceRayRecorder recorder;
+    DispatchResult result;
+    EXPECT_EQ(renderPacmanHead(traceRay, &recorder, &result), reference);
+    ASSERT_EQ(recorder.calls.size(), 3u);  // primary, shadow, reflection
+    EXPECT_EQ(recorder.calls[0].payloadSize, sizeof(RayPayload));
+    EXPECT_EQ(recorder.calls[0].arguments, traceRay[Radiance]);
+    EXPECT_EQ(recorder.calls[1].payloadSize, sizeof(ShadowRayPayload));
+    EXPECT_EQ(recorder.calls[1].arguments, traceRay[Shadow]);
+    EXPECT_EQ(recorder.calls[2].payloadSize, sizeof(RayPayload));
+    EXPECT_EQ(recorder.calls[2].arguments, traceRay[Radiance]);
+    ASSERT_FALSE(recorder.lookups.empty());
+    const HitGroupIndexTerms& primary = recorder.lookups[0];
+    EXPECT_EQ(primary.rawRayContribution, 16u);
+    EXPECT_EQ(primary.rawMultiplier, 18u);
+    EXPECT_EQ(primary.rayContribution, 0u);
+    EXPECT_EQ(primary.multiplier, 2u);
+    EXPECT_EQ(primary.index, 0u);
+    EXPECT_TRUE(result.diagnostics.find("IDX-2").has_value());
+
+    TraceRayArgumentSet masked = defaultTraceRayArguments();
+    masked[Radiance].instanceInclusionMask = 0xFFFFFF02;
+    EXPECT_EQ(renderPacmanHead(masked), kBackgroundColor);
 }
 
 // Pac-man A's mouth axis: o = (35,-35,50), d = -z, i.e. local o = (0,0,1), d = (0,0,-1).

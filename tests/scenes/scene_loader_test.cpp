@@ -2,11 +2,14 @@
 // errors a broken file gets (file:line:column, what was expected, "did you mean").
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <utility>
 
 #include "core/error.h"
+#include "procedural/d3d12/d3d12_shaders.h"
 #include "procedural/proceduray/proceduray_shaders.h"
 #include "scenes/scene_loader.h"
 #include "tests/scenes/scene_test_support.h"
@@ -98,6 +101,66 @@ TEST(SceneLoader, D3D12SceneFollowsTheFactSheet) {
     EXPECT_NEAR(s.camera("").eye.x, -12.020815, 1e-6);
     EXPECT_NEAR(s.camera("").up.y, 0.954680, 1e-6);
     EXPECT_EQ(s.defaultTime, 0.0f);
+}
+
+// Without "traceRay" a ray type gets what the library's HLSL passes to TraceRay: R = r, M = 2, miss index r and
+// the full 32-bit mask ~0.
+TEST(SceneLoader, TraceRayArgumentsDefaultToTheLibrarysValues) {
+    const std::pair<std::string, procedural::TraceRayArgumentSet> libraries[] = {
+        {kProceduray, procedural::proceduray::defaultTraceRayArguments()},
+        {kD3D12, procedural::d3d12::defaultTraceRayArguments()}};
+    for (const auto& [path, expected] : libraries) {
+        const SceneDesc s = loadSceneFile(path);
+        const ShaderLibraryBinding& binding = findShaderLibrary(s.shaderLibrary);
+        ASSERT_EQ(s.rayTypes.size(), 2u) << path;
+        ASSERT_EQ(binding.traceRayDefaults.size(), 2u) << path;
+        for (uint32_t r = 0; r < 2; ++r) {
+            const RayTypeDesc& t = s.rayTypes[r];
+            const procedural::TraceRayArguments read{t.rayContribution, t.multiplier, t.missShaderIndex,
+                                                     t.instanceInclusionMask};
+            EXPECT_EQ(read, expected[r]) << path << " ray type " << r;
+            EXPECT_EQ(read, binding.traceRayDefaults[r]) << path << " ray type " << r;
+            EXPECT_EQ(read, (procedural::TraceRayArguments{r, 2, r, 0xFFFFFFFFu})) << path << " ray type " << r;
+        }
+    }
+}
+
+// "traceRay" replaces the keys it gives and keeps the others; values past DXR's bit widths are kept as the shader
+// would pass them (the emulator masks R and M and warns, IDX-2).
+TEST(SceneLoader, TraceRayArgumentsAreReadPerRayType) {
+    const SceneDesc s = parseScene(
+        edited("{\"name\": \"Shadow\", \"miss\": \"Miss_Shadow\", \"payload\": \"ShadowRayPayload\"}",
+               "{\"name\": \"Shadow\", \"miss\": \"Miss_Shadow\", \"payload\": \"ShadowRayPayload\",\n"
+               "     \"traceRay\": {\"multiplier\": 1, \"rayContribution\": 17, \"instanceInclusionMask\": 4278190081}}"),
+        "lesson.json");
+    const RayTypeDesc& radiance = s.rayTypes[0];
+    EXPECT_EQ(radiance.multiplier, 2u);
+    EXPECT_EQ(radiance.instanceInclusionMask, 0xFFFFFFFFu);
+    const RayTypeDesc& shadow = s.rayTypes[1];
+    EXPECT_EQ(shadow.rayContribution, 17u);
+    EXPECT_EQ(shadow.multiplier, 1u);
+    EXPECT_EQ(shadow.missShaderIndex, 1u);
+    EXPECT_EQ(shadow.instanceInclusionMask, 0xFF000001u);
+}
+
+TEST(SceneLoader, MisspeltTraceRayKeyGetsDidYouMean) {
+    const std::string text =
+        edited("{\"name\": \"Radiance\", \"miss\": \"Miss\", \"payload\": \"RayPayload\"}",
+               "{\"name\": \"Radiance\", \"miss\": \"Miss\", \"payload\": \"RayPayload\", \"traceRay\": {\"multiplyer\": 1}}");
+    const size_t at = text.find("\"multiplyer\"");
+    const size_t lineStart = text.rfind('\n', at) + 1;
+    std::string where = "broken.json:";
+    where += std::to_string(std::count(text.begin(), text.begin() + std::ptrdiff_t(at), '\n') + 1);
+    where += ":";
+    where += std::to_string(at - lineStart + 1);
+    where += ": ";
+    const std::string message = loadError(text);
+    EXPECT_CONTAINS(message, where);
+    EXPECT_CONTAINS(message, "unknown key 'multiplyer' in traceRay of ray type 'Radiance' (did you mean 'multiplier'?); "
+                             "expected one of: rayContribution, multiplier, missShaderIndex, instanceInclusionMask");
+    EXPECT_CONTAINS(loadError(edited("\"payload\": \"RayPayload\"}",
+                                     "\"payload\": \"RayPayload\", \"traceRay\": {\"missShaderIndex\": 4294967296}}")),
+                    "4294967296 does not fit in a 32-bit unsigned integer");
 }
 
 TEST(SceneLoader, SyntaxErrorsNameFileLineAndColumn) {

@@ -3,10 +3,13 @@
 
 #include <cmath>
 #include <cstring>
+#include <memory>
+#include <string>
 
 #include "core/error.h"
 #include "scenes/scene.h"
 #include "scenes/scene_loader.h"
+#include "tests/scenes/scene_test_support.h"
 
 namespace refray::scenes {
 namespace {
@@ -144,6 +147,42 @@ TEST(Scene, ProcedurayOverviewShowsTheSceneContent) {
             if (p.r > 0.3f && p.g > 0.3f && p.b < 0.5f * p.r) ++yellow;
         }
     EXPECT_GT(yellow, 200u);
+}
+
+// The D3D12 scene with a "traceRay" object on each ray type (docs/scene-format.md).
+std::unique_ptr<Scene> d3d12SceneWithTraceRay(const std::string& radiance, const std::string& shadow) {
+    std::string radianceType = "\"payload\": \"RayPayload\", \"traceRay\": ";
+    radianceType += radiance;
+    radianceType += "}";
+    std::string shadowType = "\"payload\": \"ShadowRayPayload\", \"traceRay\": ";
+    shadowType += shadow;
+    shadowType += "}";
+    std::string text = testing::readText(kD3D12);
+    text = testing::edited(text, "\"payload\": \"RayPayload\"}", radianceType);
+    text = testing::edited(text, "\"payload\": \"ShadowRayPayload\"}", shadowType);
+    return std::make_unique<Scene>(parseScene(text, "d3d12-trace-ray.json"));
+}
+
+// The scene file's TraceRay arguments reach the shaders. Spelling out the HLSL's own values renders the file's image
+// bit for bit; the tutorial's lesson "a multiplier of 1 with two ray types" (I = r + G + C) sends the rays that hit
+// the AABB geometries to other geometries' records, which stay inside the table, and renders a different image.
+TEST(Scene, TraceRayArgumentsOfTheSceneFileReachTheShaders) {
+    RenderSettings s = small();
+    s.width = 64;
+    s.height = 36;
+    const RenderResult reference = loadScene(kD3D12)->render(s);
+
+    const RenderResult spelledOut =
+        d3d12SceneWithTraceRay(
+            R"({"rayContribution": 0, "multiplier": 2, "missShaderIndex": 0, "instanceInclusionMask": 4294967295})",
+            R"({"rayContribution": 1, "multiplier": 2, "missShaderIndex": 1, "instanceInclusionMask": 4294967295})")
+            ->render(s);
+    EXPECT_TRUE(sameBytes(reference.image, spelledOut.image));
+
+    const RenderResult lesson = d3d12SceneWithTraceRay(R"({"multiplier": 1})", R"({"multiplier": 1})")->render(s);
+    EXPECT_FALSE(sameBytes(reference.image, lesson.image));
+    EXPECT_EQ(nonFinitePixels(lesson.image), 0u);
+    EXPECT_TRUE(lesson.dispatch.diagnostics.empty());  // wrong records, but valid ones
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "tests/tools/browser.h"
 #include "tests/tools/cli_run.h"
 #include "core/random.h"
 
@@ -23,6 +24,7 @@ using refray::vec4;
 
 using refray::testing::CliRun;
 using refray::testing::runCommand;
+using refray::testing::dumpDom;
 
 CliRun compare(const std::string& arguments) { return runCommand(std::string(REFRAY_BINARY) + " compare " + arguments); }
 
@@ -57,44 +59,6 @@ std::string write(const std::string& path, const Image& image) {
 }
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
-
-// --- Headless Chromium -----------------------------------------------------------
-
-std::string findBrowser() {
-    for (const char* name : {"chromium", "chromium-browser"}) {
-        const CliRun r = runCommand(std::string("command -v ") + name);
-        if (r.status == 0 && !r.output.empty()) return r.output.substr(0, r.output.find('\n'));
-    }
-    return {};
-}
-
-// The DOM after the page's scripts ran, or "" with the failure in `error`.
-std::string dumpDom(const std::string& browser, const std::string& htmlPath, const std::string& profile,
-                    std::string& error) {
-    const std::string command = "timeout 120 " + browser + " --headless --disable-gpu --no-sandbox --user-data-dir=" +
-                                profile + " --dump-dom file://" + std::filesystem::absolute(htmlPath).string() +
-                                " 2>/dev/null";
-    FILE* pipe = popen(command.c_str(), "r");
-    if (!pipe) {
-        error = "cannot start " + browser;
-        return {};
-    }
-    std::string dom;
-    std::array<char, 65536> buffer;
-    size_t n;
-    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) dom.append(buffer.data(), n);
-    const int status = pclose(pipe);
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) error = "browser exited with " + std::to_string(status);
-    return dom;
-}
-
-#define REQUIRE_BROWSER(browser)                                                                              \
-    const std::string browser = findBrowser();                                                                \
-    if (browser.empty()) {                                                                                    \
-        if (std::getenv("REFRAY_ALLOW_NO_BROWSER")) GTEST_SKIP() << "chromium not installed";                 \
-        FAIL() << "chromium is not installed: run 'bash tools/setup.sh' as root (or set "                     \
-                  "REFRAY_ALLOW_NO_BROWSER=1 to skip the browser checks)";                                    \
-    }
 
 // The <tr class="comparison ..."> rows of a report, in document order.
 std::vector<std::string> comparisonRows(const std::string& dom) {
