@@ -136,9 +136,23 @@ struct GlobalArgumentDesc {
 
 enum class LayoutMode { Auto, Explicit };
 
+// What a lesson file adds to the scene it patches (empty for plain scene files).
+struct LessonDesc {
+    std::string title;
+    std::string teaches;
+    std::string base;  // the base file as the lesson names it
+    // What refray reports, exactly: the first finding of `refray table --check` ("" = none), and the diagnostic
+    // a render with `renderCamera` at `renderSize` stops with ("" = it renders without one).
+    std::string expectTable;
+    std::string renderCamera;
+    std::string renderSize = "160x90";
+    std::string expectRender;
+};
+
 struct SceneDesc {
     std::filesystem::path file;
-    std::string fileHash;  // SHA-256 of the file's bytes
+    std::string fileHash;  // SHA-256 of the file's bytes (a lesson: of its bytes and its bases')
+    LessonDesc lesson;
     std::string name;
     std::string description;
     std::string source;

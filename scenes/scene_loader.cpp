@@ -601,7 +601,8 @@ private:
             // An OBJ file, relative to the scene file: its positions and triangulated faces become two buffers.
             if (r.optional("vertices") || r.optional("indices"))
                 mesh->fail("a triangle geometry takes 'mesh' or 'vertices' (and 'indices'), not both");
-            const std::filesystem::path path = scene_.file.parent_path() / mesh->asString();
+            // Relative to the file that wrote the value (a lesson's base keeps its own directory).
+            const std::filesystem::path path = std::filesystem::path(mesh->location().file).parent_path() / mesh->asString();
             TriangleMesh data;
             try {
                 data = loadObjMesh(path);
@@ -1155,11 +1156,64 @@ int32_t SceneDesc::findBuffer(const std::string& bufferName) const {
     return -1;
 }
 
+namespace {
+
+// A lesson file (format refray-lesson/1): its base scene (or base lesson) with a JSON Patch applied. Returns the
+// patched document; `hashed` collects the text of every file in the chain, `lesson` the outermost lesson's facts.
+Value resolveLesson(Value root, const std::string& fileName, uint32_t depth, std::string& hashed, LessonDesc& lesson) {
+    const Value* format = root.isObject() ? root.find("format") : nullptr;
+    if (!format || !format->isString() || format->asString() != kLessonFormat) return root;
+    if (depth >= 8) root.fail("lessons are based on each other more than 8 deep (a cycle?)");
+    ObjectReader r(root, "a lesson");
+    r.required("format");
+    const Value& name = r.required("name");
+    const Value& base = r.required("base");
+    const Value& title = r.required("title");
+    const Value* teaches = r.optional("teaches");
+    const Value& patch = r.required("patch");
+    const Value* expect = r.optional("expect");
+    r.finish();
+    const std::filesystem::path basePath = std::filesystem::path(fileName).parent_path() / base.asString();
+    std::ifstream in(basePath, std::ios::binary);
+    if (!in) base.fail("cannot read the lesson's base " + basePath.string() + ": " + std::strerror(errno));
+    const std::string baseText((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    hashed += baseText;
+    LessonDesc inner;
+    Value document = resolveLesson(json::parse(baseText, basePath.string()), basePath.string(), depth + 1, hashed, inner);
+    json::applyPatch(document, patch);
+    if (depth == 0) {
+        lesson.title = title.asString();
+        if (teaches) lesson.teaches = teaches->asString();
+        lesson.base = base.asString();
+        if (expect) {
+            ObjectReader er(*expect, "the lesson's 'expect'");
+            if (const Value* v = er.optional("table")) lesson.expectTable = v->asString();
+            if (const Value* v = er.optional("render")) {
+                ObjectReader rr(*v, "the lesson's expected render");
+                if (const Value* c = rr.optional("camera")) lesson.renderCamera = c->asString();
+                if (const Value* z = rr.optional("size")) lesson.renderSize = z->asString();
+                lesson.expectRender = rr.required("diagnostic").asString();
+                rr.finish();
+            }
+            er.finish();
+        }
+    }
+    // The lesson's name replaces the base's (renders and messages name the lesson).
+    const std::string nameJson = "[{\"op\": \"replace\", \"path\": \"/name\", \"value\": " + jsonQuote(name.asString()) + "}]";
+    json::applyPatch(document, json::parse(nameJson, fileName));
+    return document;
+}
+
+}  // namespace
+
 SceneDesc parseScene(std::string_view text, const std::string& fileName) {
-    const Value root = json::parse(text, fileName);
+    std::string hashed(text);
+    LessonDesc lesson;
+    const Value root = resolveLesson(json::parse(text, fileName), fileName, 0, hashed, lesson);
     SceneDesc scene;
     scene.file = fileName;
-    scene.fileHash = sha256Hex(text);
+    scene.fileHash = sha256Hex(hashed);
+    scene.lesson = std::move(lesson);
     Loader(root, scene).load();
     return scene;
 }

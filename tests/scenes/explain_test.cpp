@@ -75,20 +75,43 @@ TEST(Explain, IDX_1_ProcedurayPixelOnPacmanMatchesTheHandComputation) {
     EXPECT_EQ(*x.pixel, full.image.at(112, 100));
 }
 
-// The D3D12 sample: the procedural BLAS holds ten AABB geometries, C = 2, M = 2. The first pixel whose primary
-// ray the record index map puts on record 8 is geometry 3: 0 + 2×3 + 2 = 8.
+// The D3D12 sample: the procedural BLAS holds ten AABB geometries, C = 2, M = 2. Pixel (238, 82) at 320x180 lies
+// on geometry 3 (the index map agrees): 0 + 2×3 + 2 = 8, at StartAddress + 96×8.
 TEST(Explain, IDX_1_D3D12PixelOnGeometryThreeMatchesTheHandComputation) {
     auto scene = loadScene(kD3D12);
     const IndexMap map = renderIndexMap(*scene, small(), IndexMapKind::Record);
-    const auto it = std::find(map.values.begin(), map.values.end(), 8);
-    ASSERT_NE(it, map.values.end());
-    const uint32_t i = uint32_t(it - map.values.begin()), x = i % 320, y = i / 320;
-    const Explanation e = explainPixel(*scene, small(), x, y);
+    EXPECT_EQ(map.values[82 * 320 + 238], 8);
+    const Explanation e = explainPixel(*scene, small(), 238, 82);
     ASSERT_FALSE(e.error);
     const std::string text = formatExplanation(e, scene->desc());
     EXPECT_CONTAINS(text, "hit-group record: I = R + M×G + C = 0 + 2×3 + 2 = 8; address = StartAddress + 96×8 = ");
     EXPECT_CONTAINS(text, "'MyHitGroup_AABB_SignedDistancePrimitive'");
     EXPECT_CONTAINS(text, "result of TraceRay #1: hit instance 1 'primitives' (InstanceID 0), geometry 3, primitive 0");
+}
+
+// docs/tutorial-indexing.md quotes these explanations; its hand computations must stay true.
+TEST(Explain, TheTutorialQuotesTheExplanationsItComputesByHand) {
+    const std::string tutorial = testing::readText(std::string(REFRAY_SOURCE_DIR) + "/docs/tutorial-indexing.md");
+    struct Case {
+        std::string scene;
+        uint32_t x, y;
+    };
+    for (const Case& c : {Case{kProceduray, 112, 100}, Case{kD3D12, 238, 82}}) {
+        auto scene = loadScene(c.scene);
+        const std::string text = formatExplanation(explainPixel(*scene, small(), c.x, c.y), scene->desc());
+        size_t quoted = 0;
+        for (size_t at = 0, end; at < text.size(); at = end + 1) {
+            end = text.find('\n', at);
+            if (end == std::string::npos) end = text.size();
+            std::string line = text.substr(at, end - at);
+            line.erase(0, line.find_first_not_of(' '));
+            if (line.rfind("hit-group record:", 0) == 0 || line.rfind("miss shader table record", 0) == 0 ||
+                line.rfind("TraceRay #", 0) == 0) {
+                if (tutorial.find(line) != std::string::npos) ++quoted;
+            }
+        }
+        EXPECT_GE(quoted, 3u) << "the tutorial should quote the record lines of " << c.scene << " pixel " << c.x << "," << c.y;
+    }
 }
 
 TEST(Explain, AMissIsExplainedWithItsMissRecord) {
