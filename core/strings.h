@@ -20,8 +20,6 @@ std::string didYouMean(std::string_view name, const std::vector<std::string>& ca
 // "a, b, c".
 std::string joined(const std::vector<std::string>& names, std::string_view separator = ", ");
 
-// `text` as a JSON string literal, quotes included (control characters escaped).
-std::string jsonQuote(std::string_view text);
 // `text` with &, <, >, " and ' escaped for HTML.
 std::string htmlEscape(std::string_view text);
 // A float as the shortest decimal text that reads back as the same float ("0.1", "1e+30", "nan").

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/json_writer.h"
 #include "core/strings.h"
 
 namespace refray::scenes {
@@ -376,14 +377,14 @@ const char* kindName(Kind k) {
 
 std::string jsonNumber(float v) {
     const std::string s = shortestFloat(v);
-    return std::isfinite(v) ? s : jsonQuote(s);  // JSON has no NaN or infinity
+    return std::isfinite(v) ? s : json::quoted(s);  // JSON has no NaN or infinity
 }
 
 std::string jsonVec3(const vec3& v) { return "[" + jsonNumber(v.x) + ", " + jsonNumber(v.y) + ", " + jsonNumber(v.z) + "]"; }
 
 std::string diagnosticJson(const dxr::Diagnostic& d) {
-    std::string out = "{\"rule\": " + jsonQuote(d.ruleId) + ", \"message\": " + jsonQuote(d.message) +
-                      ", \"text\": " + jsonQuote(d.format()) + "}";
+    std::string out = "{\"rule\": " + json::quoted(d.ruleId) + ", \"message\": " + json::quoted(d.message) +
+                      ", \"text\": " + json::quoted(d.format()) + "}";
     return out;
 }
 
@@ -392,8 +393,8 @@ std::string diagnosticJson(const dxr::Diagnostic& d) {
 std::string explanationJson(const Explanation& x, const SceneDesc& scene) {
     std::ostringstream o;
     o << "{\n  \"format\": \"refray-explain/1\",\n";
-    o << "  \"scene\": " << jsonQuote(x.scene) << ", \"camera\": " << jsonQuote(x.camera) << ", \"time\": " << jsonQuote(x.time)
-      << ", \"precision\": " << jsonQuote(x.precision) << ",\n";
+    o << "  \"scene\": " << json::quoted(x.scene) << ", \"camera\": " << json::quoted(x.camera) << ", \"time\": " << json::quoted(x.time)
+      << ", \"precision\": " << json::quoted(x.precision) << ",\n";
     o << "  \"size\": [" << x.width << ", " << x.height << "], \"pixel\": [" << x.x << ", " << x.y << "],\n";
     if (x.pixel)
         o << "  \"value\": [" << jsonNumber(x.pixel->r) << ", " << jsonNumber(x.pixel->g) << ", " << jsonNumber(x.pixel->b)
@@ -408,26 +409,26 @@ std::string explanationJson(const Explanation& x, const SceneDesc& scene) {
         o << "    {\"kind\": \"" << kindName(e.kind) << "\", \"depth\": " << e.depth;
         switch (e.kind) {
             case Kind::ShaderCall:
-                o << ", \"stage\": " << jsonQuote(std::string(dxr::toString(e.stage))) << ", \"export\": " << jsonQuote(r.exportName)
+                o << ", \"stage\": " << json::quoted(std::string(dxr::toString(e.stage))) << ", \"export\": " << json::quoted(r.exportName)
                   << ", \"recordIndex\": " << e.recordIndex << ", \"recordAddress\": " << e.recordAddress;
                 break;
             case Kind::TraceRay:
             case Kind::TraceRayEnd: {
                 const std::string type = rayTypeName(scene, e);
-                o << ", \"rayType\": " << (type.empty() ? "null" : jsonQuote(type)) << ", \"origin\": " << jsonVec3(e.ray.Origin)
+                o << ", \"rayType\": " << (type.empty() ? "null" : json::quoted(type)) << ", \"origin\": " << jsonVec3(e.ray.Origin)
                   << ", \"direction\": " << jsonVec3(e.ray.Direction) << ", \"tMin\": " << jsonNumber(e.ray.TMin)
                   << ", \"tMax\": " << jsonNumber(e.ray.TMax) << ", \"rayFlags\": " << e.rayFlags
-                  << ", \"rayFlagNames\": " << jsonQuote(dxr::rayFlagsToString(e.rayFlags))
+                  << ", \"rayFlagNames\": " << json::quoted(dxr::rayFlagsToString(e.rayFlags))
                   << ", \"instanceInclusionMask\": " << e.instanceInclusionMask << ", \"rayContribution\": " << e.rayContribution
                   << ", \"multiplier\": " << e.multiplier << ", \"missShaderIndex\": " << e.missShaderIndex
-                  << ", \"payloadType\": " << jsonQuote(r.payloadType)
-                  << ", \"payload\": " << jsonQuote(describePayload(r.payloadType, r.payload));
+                  << ", \"payloadType\": " << json::quoted(r.payloadType)
+                  << ", \"payload\": " << json::quoted(describePayload(r.payloadType, r.payload));
                 if (e.kind == Kind::TraceRayEnd) {
                     o << ", \"hit\": " << (e.committed ? "true" : "false");
                     if (e.committed)
                         o << ", \"instanceIndex\": " << e.instanceIndex << ", \"geometryIndex\": " << e.geometryIndex
                           << ", \"primitiveIndex\": " << e.primitiveIndex << ", \"t\": " << jsonNumber(e.t);
-                    if (!r.note.empty()) o << ", \"note\": " << jsonQuote(r.note);
+                    if (!r.note.empty()) o << ", \"note\": " << json::quoted(r.note);
                 }
                 break;
             }
@@ -440,14 +441,14 @@ std::string explanationJson(const Explanation& x, const SceneDesc& scene) {
                   << ", \"t\": " << jsonNumber(e.t);
                 if (e.kind == Kind::Candidate) o << ", \"procedural\": " << (e.procedural ? "true" : "false");
                 if (e.kind != Kind::Candidate) o << ", \"hitKind\": " << e.hitKind;
-                if (!r.note.empty()) o << ", \"note\": " << jsonQuote(r.note);
+                if (!r.note.empty()) o << ", \"note\": " << json::quoted(r.note);
                 break;
-            case Kind::Skipped: o << ", \"note\": " << jsonQuote(r.note); break;
+            case Kind::Skipped: o << ", \"note\": " << json::quoted(r.note); break;
             case Kind::RecordLookup:
-                o << ", \"table\": " << jsonQuote(r.table) << ", \"recordIndex\": " << e.recordIndex
+                o << ", \"table\": " << json::quoted(r.table) << ", \"recordIndex\": " << e.recordIndex
                   << ", \"recordAddress\": " << e.recordAddress << ", \"stride\": " << e.stride
-                  << ", \"entry\": " << (r.note.empty() ? jsonQuote(r.exportName) : "null")
-                  << ", \"status\": " << jsonQuote(r.note.empty() ? "ok" : r.note);
+                  << ", \"entry\": " << (r.note.empty() ? json::quoted(r.exportName) : "null")
+                  << ", \"status\": " << json::quoted(r.note.empty() ? "ok" : r.note);
                 if (e.hasTerms)
                     o << ", \"R\": " << e.terms.rayContribution << ", \"M\": " << e.terms.multiplier << ", \"G\": " << e.terms.geometryIndex
                       << ", \"C\": " << e.terms.instanceContribution << ", \"I\": " << e.terms.index;

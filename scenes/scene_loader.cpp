@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "core/error.h"
+#include "core/json_writer.h"
 #include "core/hash.h"
 #include "core/strings.h"
 #include "scenes/mesh.h"
@@ -20,12 +21,6 @@ using json::ObjectReader;
 using json::Value;
 
 std::string inQuotes(const std::string& s) { return "'" + s + "'"; }
-
-std::string joined(const std::vector<std::string>& names) {
-    std::string s;
-    for (const std::string& n : names) s += (s.empty() ? "" : ", ") + n;
-    return s;
-}
 
 // An index into `names` for the string `value`, or an error at its location with a "did you mean".
 uint32_t resolveName(const Value& value, const std::vector<std::string>& names, const std::string& kind) {
@@ -1199,7 +1194,7 @@ Value resolveLesson(Value root, const std::string& fileName, uint32_t depth, std
         }
     }
     // The lesson's name replaces the base's (renders and messages name the lesson).
-    const std::string nameJson = "[{\"op\": \"replace\", \"path\": \"/name\", \"value\": " + jsonQuote(name.asString()) + "}]";
+    const std::string nameJson = "[{\"op\": \"replace\", \"path\": \"/name\", \"value\": " + json::quoted(name.asString()) + "}]";
     json::applyPatch(document, json::parse(nameJson, fileName));
     return document;
 }

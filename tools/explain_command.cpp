@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/json_writer.h"
 #include "core/strings.h"
 #include "scenes/explain.h"
 #include "tools/cli_common.h"
@@ -56,19 +57,19 @@ std::string explainPage(const scenes::PixelTrees& trees, const scenes::SceneDesc
     page << "<div id=\"panel\"><div id=\"pixel\">no pixel selected</div><pre id=\"explanation\"></pre>"
          << "<p><code id=\"command\"></code></p></div></div>\n<script>\n";
     page << "const W=" << trees.width << ",H=" << trees.height << ",S=" << scale << ";\n";
-    page << "const command=" << jsonQuote(command) << ";\n";
+    page << "const command=" << json::quoted(command) << ";\n";
     std::vector<std::string> names;
-    for (const scenes::InstanceDescFile& i : desc.instances) names.push_back(jsonQuote(i.name));
+    for (const scenes::InstanceDescFile& i : desc.instances) names.push_back(json::quoted(i.name));
     page << "const instances=[" << joined(names) << "];\n";
     names.clear();
-    for (const scenes::RecordDesc& r : desc.hitGroupRecords) names.push_back(r.hitGroup.empty() ? "null" : jsonQuote(r.hitGroup));
+    for (const scenes::RecordDesc& r : desc.hitGroupRecords) names.push_back(r.hitGroup.empty() ? "null" : json::quoted(r.hitGroup));
     page << "const records=[" << joined(names) << "];\n";
     names.clear();
-    for (const std::string& m : desc.missRecords) names.push_back(m.empty() ? "null" : jsonQuote(m));
+    for (const std::string& m : desc.missRecords) names.push_back(m.empty() ? "null" : json::quoted(m));
     page << "const missRecords=[" << joined(names) << "];\n";
     names.clear();
     for (const scenes::RayTypeDesc& t : desc.rayTypes)
-        names.push_back("[" + jsonQuote(t.name) + "," + std::to_string(t.rayContribution) + "," + std::to_string(t.multiplier) +
+        names.push_back("[" + json::quoted(t.name) + "," + std::to_string(t.rayContribution) + "," + std::to_string(t.multiplier) +
                         "," + std::to_string(t.missShaderIndex) + "]");
     page << "const rayTypes=[" << joined(names) << "];\n";
     page << "const rays=[\n";
@@ -88,7 +89,7 @@ std::string explainPage(const scenes::PixelTrees& trees, const scenes::SceneDesc
     }
     page << "];\n";
     names.clear();
-    for (uint32_t f : flagValues) names.push_back(jsonQuote(std::to_string(f)) + ":" + jsonQuote(dxr::rayFlagsToString(f)));
+    for (uint32_t f : flagValues) names.push_back(json::quoted(std::to_string(f)) + ":" + json::quoted(dxr::rayFlagsToString(f)));
     page << "const flagNames={" << joined(names) << "};\n";
     page << R"JS(
 function q(s){return "'"+s+"'";}
