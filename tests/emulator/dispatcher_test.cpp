@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <mutex>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -2395,4 +2396,123 @@ TEST(Dispatcher, GEN_4_WarningsDoNotChangeResults) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------
+// Trace events (emulator/trace.h) and launch regions: what refray explain records.
+
+namespace {
+
+struct EventLog : TraceObserver {
+    std::mutex lock;
+    std::vector<std::string> lines;
+    void onEvent(const TraceEvent& e) override {
+        std::string s;
+        switch (e.kind) {
+            case TraceEvent::Kind::TraceRay: s = "TraceRay R" + std::to_string(e.rayContribution) + " M" + std::to_string(e.multiplier); break;
+            case TraceEvent::Kind::Candidate: s = "Candidate p" + std::to_string(e.primitiveIndex); break;
+            case TraceEvent::Kind::Skipped: s = "Skipped " + std::string(e.note); break;
+            case TraceEvent::Kind::RecordLookup:
+                s = "Record " + std::string(e.table) + " " + std::to_string(e.recordIndex) + " " + std::string(e.exportName);
+                if (e.hasTerms) s += " I=" + std::to_string(e.terms.index) + " G=" + std::to_string(e.terms.geometryIndex);
+                break;
+            case TraceEvent::Kind::ShaderCall: s = "Call " + std::string(e.exportName); break;
+            case TraceEvent::Kind::ReportHit: s = "ReportHit " + std::string(e.note); break;
+            case TraceEvent::Kind::AnyHit: s = "AnyHit p" + std::to_string(e.primitiveIndex) + " " + std::string(e.note); break;
+            case TraceEvent::Kind::Commit: s = "Commit p" + std::to_string(e.primitiveIndex); break;
+            case TraceEvent::Kind::TraceRayEnd: s = e.committed ? "End hit p" + std::to_string(e.primitiveIndex) : "End miss"; break;
+        }
+        std::lock_guard<std::mutex> guard(lock);
+        lines.push_back(s);
+    }
+};
+
+}  // namespace
+
+TEST(Dispatcher, TraceEventsFollowTheAnyHitDecisionsAndTheRecords) {
+    // Two non-opaque triangles on the ray: primitive 1 at t = 3, primitive 0 at t = 5. The any-hit shader
+    // ignores primitive 1, so primitive 0 is committed and its closest-hit shader runs.
+    Rig r;
+    const auto tri = r.h.blas({r.h.triangles({triAt(0)[0], triAt(0)[1], triAt(0)[2], triAt(-2)[0], triAt(-2)[1], triAt(-2)[2]},
+                                             GEOMETRY_FLAG_NONE)});
+    r.h.tlas({Harness::instance(tri)});
+    r.ahTri = [](ShaderContext& ctx, Probe&, const BuiltInTriangleIntersectionAttributes&) {
+        if (ctx.PrimitiveIndex() == 1) ctx.IgnoreHit();
+    };
+    EventLog log;
+    DispatchOptions options;
+    options.observer = &log;
+    r.run({"HG_TriS"}, uvec3(1u), options);
+    const std::vector<std::string> expected = {
+        "Record ray generation record 0 RG",
+        "Call RG",
+        "TraceRay R0 M1",
+        "Candidate p1",
+        "Record hit-group table 0 HG_TriS I=0 G=0",
+        "Call AH_TriS",
+        "AnyHit p1 IgnoreHit: the candidate is dropped",
+        "Candidate p0",
+        "Record hit-group table 0 HG_TriS I=0 G=0",
+        "Call AH_TriS",
+        "AnyHit p0 accept (returned normally)",
+        "Commit p0",
+        "Record hit-group table 0 HG_TriS I=0 G=0",
+        "Call CH_TriS",
+        "End hit p0",
+    };
+    EXPECT_EQ(log.lines, expected);
+    EXPECT_EQ(r.result.primitiveIndex, 0u);
+}
+
+TEST(Dispatcher, TraceEventsOfACulledTriangleAndTheMissThatFollows) {
+    // The ray meets one face of the triangle: exactly one of the two cull flags drops it (FLAG-10), and the
+    // log of that run says so, then reads miss record 0.
+    Rig r;
+    r.h.tlas({Harness::instance(r.h.blas({r.h.triangles(triAt(0))}))});
+    int culledRuns = 0;
+    for (const uint32_t cull : {RAY_FLAG_CULL_BACK_FACING_TRIANGLES, RAY_FLAG_CULL_FRONT_FACING_TRIANGLES}) {
+        EventLog log;
+        DispatchOptions options;
+        options.observer = &log;
+        r.args.flags = cull | RAY_FLAG_FORCE_OPAQUE;
+        r.run({"HG_TriS"}, uvec3(1u), options);
+        const std::string skip = cull == RAY_FLAG_CULL_BACK_FACING_TRIANGLES
+                                     ? "Skipped back face culled: CULL_BACK_FACING_TRIANGLES (FLAG-10)"
+                                     : "Skipped front face culled: CULL_FRONT_FACING_TRIANGLES (FLAG-10)";
+        if (std::find(log.lines.begin(), log.lines.end(), skip) == log.lines.end()) {
+            EXPECT_EQ(log.lines.back(), "End hit p0");
+            continue;
+        }
+        ++culledRuns;
+        EXPECT_EQ(log.lines.back(), "End miss");
+        EXPECT_NE(std::find(log.lines.begin(), log.lines.end(), "Record miss shader table 0 Miss_S"), log.lines.end());
+        EXPECT_EQ(r.result.misses, 1u);
+    }
+    EXPECT_EQ(culledRuns, 1);
+}
+
+TEST(Dispatcher, ALaunchRegionRunsOnlyItsLaunchIndices) {
+    Rig r;
+    r.h.tlas({Harness::instance(r.h.blas({r.h.triangles(triAt(0))}))});
+    std::mutex lock;
+    std::vector<uvec3> ran;
+    r.rg = [&](ShaderContext& ctx) {
+        std::lock_guard<std::mutex> guard(lock);
+        ran.push_back(ctx.DispatchRaysIndex());
+        EXPECT_EQ(ctx.DispatchRaysDimensions(), uvec3(8, 6, 1));  // the full dispatch's
+    };
+    DispatchOptions options;
+    options.region = LaunchRegion{5, 2, 2, 3};
+    r.run({"HG_TriS"}, uvec3(8, 6, 1), options);
+    std::sort(ran.begin(), ran.end(), [](uvec3 a, uvec3 b) { return a.y != b.y ? a.y < b.y : a.x < b.x; });
+    EXPECT_EQ(ran, (std::vector<uvec3>{{5, 2, 0}, {6, 2, 0}, {5, 3, 0}, {6, 3, 0}, {5, 4, 0}, {6, 4, 0}}));
+
+    options.region = LaunchRegion{7, 0, 2, 1};
+    try {
+        r.run({"HG_TriS"}, uvec3(8, 6, 1), options);
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_STREQ(e.what(), "the launch region 2x1 at (7, 0) is not inside the 8x6 dispatch");
+    }
+}
+
 }  // namespace refray::test
