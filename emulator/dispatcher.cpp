@@ -584,9 +584,23 @@ void orderCandidates(ThreadState& ts, RayState& rs) {
     std::shuffle(cs.begin(), cs.end(), rng);
 }
 
+// Embree's traversal accepts origin and direction components up to ±1.844e18 (its FLT_LARGE) and asserts
+// beyond; refray treats a finite ray beyond that like an infinite one (RAY-7: a warning, then a miss).
+constexpr float kTraversalRange = 1.844e18f;
+bool inTraversalRange(const RayDesc& ray) {
+    for (int c = 0; c < 3; ++c)
+        if (!(std::fabs(ray.Origin[c]) <= kTraversalRange && std::fabs(ray.Direction[c]) <= kTraversalRange)) return false;
+    return true;
+}
+
+std::string vec3Values(const vec3& v) {
+    return std::to_string(v.x) + "," + std::to_string(v.y) + "," + std::to_string(v.z);
+}
+
 void validateRay(ThreadState& ts, const Site& site, const RayDesc& ray, bool& ok) {
     const bool finite = allFinite(ray.Origin) && allFinite(ray.Direction) && std::isfinite(ray.TMin);
-    if (finite && !std::isnan(ray.TMax) && ray.TMin >= 0.0f && ray.TMin <= ray.TMax && ray.Direction != vec3(0.0f))
+    if (finite && !std::isnan(ray.TMax) && ray.TMin >= 0.0f && ray.TMin <= ray.TMax && ray.Direction != vec3(0.0f) &&
+        inTraversalRange(ray))
         return;  // the common case: nothing to report
     auto field = [&](const char* name, float v) {
         if (std::isnan(v)) {
@@ -616,8 +630,13 @@ void validateRay(ThreadState& ts, const Site& site, const RayDesc& ray, bool& ok
         warn(ts, site, warning("RAY-7", "RayDesc.Direction is the zero vector"));
     else if (!allFinite(ray.Origin) || !allFinite(ray.Direction))
         warn(ts, site, warning("RAY-7", "RayDesc has an infinite Origin or Direction component")
-                           .value("Origin", std::to_string(ray.Origin.x) + "," + std::to_string(ray.Origin.y) + "," + std::to_string(ray.Origin.z))
-                           .value("Direction", std::to_string(ray.Direction.x) + "," + std::to_string(ray.Direction.y) + "," + std::to_string(ray.Direction.z)));
+                           .value("Origin", vec3Values(ray.Origin))
+                           .value("Direction", vec3Values(ray.Direction)));
+    else if (!inTraversalRange(ray))
+        warn(ts, site, warning("RAY-7", "RayDesc has an Origin or Direction component beyond +-1.844e18, the range "
+                                        "refray's traversal (Embree) accepts; the ray is treated as a miss")
+                           .value("Origin", vec3Values(ray.Origin))
+                           .value("Direction", vec3Values(ray.Direction)));
 }
 
 // FLAG-2..5 on the effective flags; returns false (and has raised) when they are invalid.
@@ -729,7 +748,7 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
 
     // RAY-7: an infinite origin or direction component makes the plain math NaN, so the
     // ray finds nothing (and Embree, which refuses such rays, never sees it).
-    const bool traceable = allFinite(ray.Origin) && allFinite(ray.Direction);
+    const bool traceable = allFinite(ray.Origin) && allFinite(ray.Direction) && inTraversalRange(ray);
     if (asAddress != 0 && traceable) {
         if (asAddress != ts.lastTlasAddress) {
             ts.lastTlas = ds.device->findTopLevelAS(asAddress);

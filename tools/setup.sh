@@ -10,6 +10,7 @@ packages=(
   libcli11-dev libtinyobjloader-dev
   chromium  # the compare tool's HTML report is checked in headless Chromium
   fonts-dejavu-core  # legends of index maps (refray render --aov) are drawn with DejaVu Sans
+  clang libclang-rt-14-dev  # libFuzzer programs (tools/fuzz.sh)
 )
 
 missing=()
