@@ -23,25 +23,20 @@
 #include "procedural/math/fractals.h"
 #include "procedural/math/metaballs.h"
 #include "procedural/math/sdf.h"
+#include "tests/procedural/sweep_support.h"
 
 namespace {
 
 using namespace refray::procedural::math;
 namespace hlsl = refray::procedural::hlsl;
 using glm::dvec3;
+using testing::canonicalT1;
+using testing::radianceExtent;
+using testing::randomUnit;
 
 constexpr std::size_t kSetSize = 256;  // points / rays per set (a power of two)
 
 // ---- fixed inputs --------------------------------------------------------------------------------
-
-dvec3 randomUnit(std::mt19937& rng) {
-    std::normal_distribution<double> n(0.0, 1.0);
-    for (;;) {
-        const dvec3 v(n(rng), n(rng), n(rng));
-        const double l = glm::length(v);
-        if (l > 1e-6) return v / l;
-    }
-}
 
 // Points with |p - centre| in [rMin, rMax] (uniform radius, uniform direction), rounded to T.
 template <typename T>
@@ -80,22 +75,6 @@ std::vector<Ray<T>> hittingRays(std::uint32_t seed, const dvec3& centre, double 
         if (hits(ray)) rays.push_back(ray);
     }
     return rays;
-}
-
-template <typename T>
-RayExtent<T> radianceExtent() {
-    RayExtent<T> e;
-    e.tMin = T(0);
-    e.tCurrent = T(10000);
-    e.cullBackFacing = true;  // both samples' radiance and shadow rays cull back faces
-    return e;
-}
-
-float canonicalT1() {  // Proceduray fact sheet §1.9: float bits 0x417D7CD8
-    const std::uint32_t bits = 0x417D7CD8u;
-    float t = 0;
-    std::memcpy(&t, &bits, sizeof t);
-    return t;
 }
 
 template <typename T>

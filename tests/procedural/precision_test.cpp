@@ -19,6 +19,7 @@
 #include "procedural/math/fractals.h"
 #include "procedural/math/metaballs.h"
 #include "procedural/math/sdf.h"
+#include "tests/procedural/sweep_support.h"
 
 #include <algorithm>
 #include <cmath>
@@ -39,26 +40,14 @@ namespace {
 
 using glm::dvec3;
 using glm::vec3;
+using testing::canonicalT1;
+using testing::radianceExtent;
+using testing::randomUnit;
+using testing::RayPair;
 
 constexpr int kPoints = 2000;
 constexpr int kRays = 1000;
 constexpr std::uint32_t kSeed = 20240603u;
-
-float canonicalT1() {  // Proceduray fact sheet §1.9: float bits 0x417D7CD8
-    const std::uint32_t bits = 0x417D7CD8u;
-    float t = 0;
-    std::memcpy(&t, &bits, sizeof t);
-    return t;
-}
-
-dvec3 randomUnit(std::mt19937& rng) {
-    std::normal_distribution<double> n(0.0, 1.0);
-    for (;;) {
-        const dvec3 v(n(rng), n(rng), n(rng));
-        const double l = glm::length(v);
-        if (l > 1e-6) return v / l;
-    }
-}
 
 // Distance of p from the y axis relative to |p|: sin of the angle to the axis.
 double offAxis(const dvec3& p) { return std::sqrt(p.x * p.x + p.z * p.z) / glm::length(p); }
@@ -212,13 +201,8 @@ struct MarchBound {
     double tRel;
 };
 
-// A ray in float (origin on a sphere, aimed within rAim of `target`, unit direction) and the same
-// ray promoted to double.
-struct RayPair {
-    Ray<float> f;
-    Ray<double> d;
-};
-
+// kRays rays from the sphere of radius rOrigin around `centre`, aimed within rAim of `target`, each in
+// float and promoted exactly to double (testing::rayPair).
 std::vector<RayPair> rays(std::uint32_t seed, const dvec3& centre, double rOrigin, const dvec3& target, double rAim) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -226,12 +210,7 @@ std::vector<RayPair> rays(std::uint32_t seed, const dvec3& centre, double rOrigi
     while (int(out.size()) < kRays) {
         const dvec3 o = centre + rOrigin * randomUnit(rng);
         const dvec3 aim = target + rAim * std::cbrt(u(rng)) * randomUnit(rng);
-        RayPair r;
-        r.f.origin = vec3(o);
-        r.f.direction = hlsl::normalize(vec3(glm::normalize(aim - o)));
-        r.d.origin = dvec3(r.f.origin);
-        r.d.direction = dvec3(r.f.direction);
-        out.push_back(r);
+        out.push_back(testing::rayPair(o, aim));
     }
     return out;
 }
@@ -268,15 +247,6 @@ void checkMarch(const std::string& name, const std::vector<RayPair>& rs,
     EXPECT_GE(rate, bound.minAgreement) << name;
     EXPECT_GT(joint, int(rs.size()) / 4) << name << ": too few joint hits to measure t";
     EXPECT_EQ(tFailures, 0) << name;
-}
-
-template <typename T>
-RayExtent<T> radianceExtent() {
-    RayExtent<T> e;
-    e.tMin = T(0);
-    e.tCurrent = T(10000);
-    e.cullBackFacing = true;
-    return e;
 }
 
 // Mandelbulb march, local rays from radius 2 aimed within 0.9 of the centre (a mix of hits and
@@ -336,12 +306,7 @@ std::vector<RayPair> juliaSideRays(std::uint32_t seed) {
         const double phi = 2 * std::numbers::pi * u(rng);
         const dvec3 o(1.6 * std::cos(phi), -0.9 + 0.7 * u(rng), 1.6 * std::sin(phi));
         const dvec3 aim = dvec3(0, -0.55, 0) + 0.5 * std::cbrt(u(rng)) * randomUnit(rng);
-        RayPair r;
-        r.f.origin = vec3(o);
-        r.f.direction = hlsl::normalize(vec3(glm::normalize(aim - o)));
-        r.d.origin = dvec3(r.f.origin);
-        r.d.direction = dvec3(r.f.direction);
-        out.push_back(r);
+        out.push_back(testing::rayPair(o, aim));
     }
     return out;
 }

@@ -18,6 +18,7 @@
 #include "procedural/math/fractals.h"
 #include "procedural/math/metaballs.h"
 #include "procedural/math/sdf.h"
+#include "tests/procedural/sweep_support.h"
 
 #include <algorithm>
 #include <chrono>
@@ -37,22 +38,12 @@ namespace {
 
 using glm::dvec3;
 using glm::vec3;
+using testing::canonicalT1;
+using testing::radianceExtent;
+using testing::randomUnit;
+using testing::RayPair;
 
 constexpr int kRays = 10000;
-
-struct RayPair {
-    Ray<float> f;
-    Ray<double> d;
-};
-
-dvec3 randomUnit(std::mt19937& rng) {
-    std::normal_distribution<double> n(0.0, 1.0);
-    for (;;) {
-        const dvec3 v(n(rng), n(rng), n(rng));
-        const double l = glm::length(v);
-        if (l > 1e-6) return v / l;
-    }
-}
 
 // kRays rays: origin on the sphere (centre of the box, rOrigin), aimed at a uniform point of
 // the box [lo, hi]; unit float direction, promoted exactly to double.
@@ -65,12 +56,7 @@ std::vector<RayPair> sweepRays(std::uint32_t seed, const dvec3& lo, const dvec3&
     while (int(out.size()) < kRays) {
         const dvec3 o = centre + rOrigin * randomUnit(rng);
         const dvec3 aim(lo.x + (hi.x - lo.x) * u(rng), lo.y + (hi.y - lo.y) * u(rng), lo.z + (hi.z - lo.z) * u(rng));
-        RayPair r;
-        r.f.origin = vec3(o);
-        r.f.direction = hlsl::normalize(vec3(glm::normalize(aim - o)));
-        r.d.origin = dvec3(r.f.origin);
-        r.d.direction = dvec3(r.f.direction);
-        out.push_back(r);
+        out.push_back(testing::rayPair(o, aim));
     }
     return out;
 }
@@ -147,22 +133,6 @@ std::vector<Outcome> floatVsDouble(const std::string& name, const std::vector<Ra
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     reportAndCheck(name + ".float_vs_double", compare(f, d), bound, seconds);
     return d;
-}
-
-template <typename T>
-RayExtent<T> radianceExtent() {
-    RayExtent<T> e;
-    e.tMin = T(0);
-    e.tCurrent = T(10000);
-    e.cullBackFacing = true;  // both samples' radiance and shadow rays cull back faces
-    return e;
-}
-
-float canonicalT1() {  // Proceduray fact sheet §1.9: float bits 0x417D7CD8
-    const std::uint32_t bits = 0x417D7CD8u;
-    float t = 0;
-    std::memcpy(&t, &bits, sizeof t);
-    return t;
 }
 
 using LD = long double;
