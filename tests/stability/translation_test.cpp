@@ -1,0 +1,309 @@
+// Stability: an object's image under translation of the whole scene (issue 6).
+//
+// The scene is tests/scenes/table_view_test.cpp's kExplicit (the D3D12 sample's shader library, its ground plane
+// and one AABB of analytic spheres) with every world position moved by an offset: both instance translations, the
+// camera's eye and target, and the light. The spheres' `primitiveTransforms` centre is object space (the AABB's
+// centre in the BLAS) and the ground's vertices are object space, so neither moves. The offset is
+// (D, D/2, -D) with D an even integer, so the inputs are exact floats and the ground's checkers (period 2 in world
+// x and z) land on the same squares; any difference in the image is rounding inside the pipeline.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "scenes/render_settings.h"
+#include "scenes/scene.h"
+#include "scenes/scene_loader.h"
+
+namespace refray::scenes {
+namespace {
+
+using procedural::Precision;
+
+// "%.17g" of a double: the exact value of every number the scenes below use.
+std::string num(double v) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.17g", v);
+    return buffer;
+}
+
+std::string vec3Text(double x, double y, double z) {
+    std::string text = "[";
+    text += num(x);
+    text += ", ";
+    text += num(y);
+    text += ", ";
+    text += num(z);
+    text += "]";
+    return text;  // appended piece by piece: GCC 12's -Wrestrict misfires on chains of operator+
+}
+
+// What varies between the scenes of this file: where the world origin is, the spheres' instance scale, the camera
+// and light (given for offset 0), and whether the ground plane is there. A scaled instance is not tested: with
+// scale 100 x 30 x 100 (camera and light pulled back 100 times) the analytic spheres covered no pixel at all.
+struct Layout {
+    double offset[3] = {0, 0, 0};
+    double scale[3] = {1, 1, 1};
+    double eye[3] = {0, 4, -9};
+    double target[3] = {0, 1.5, 0};
+    double light[3] = {0, 18, -20};
+    double nearPlane = 0.01;
+    double farPlane = 125;
+    bool ground = true;
+};
+
+std::string sceneText(const Layout& l) {
+    const double* o = l.offset;
+    std::string groundInstance = R"({"name": "ground", "blas": "Plane", "mask": 1, "transform": {"scale": [40, 1, 40], "translate": )";
+    groundInstance += vec3Text(-20 + o[0], o[1], -20 + o[2]);
+    groundInstance += R"(}, "contribution": 0},
+    )";
+    std::string text = R"({
+  "format": "refray-scene/1",
+  "name": "translated-ground-and-spheres",
+  "shaderLibrary": "d3d12-procedural-geometry",
+  "layout": "explicit",
+  "pipeline": {"rayGeneration": "MyRaygenShader", "maxRecursionDepth": 3, "maxPayloadBytes": 20, "maxAttributeBytes": 12},
+  "rayTypes": [
+    {"name": "Radiance", "miss": "MyMissShader", "payload": "RayPayload"},
+    {"name": "Shadow", "miss": "MyMissShader_ShadowRay", "payload": "ShadowRayPayload"}
+  ],
+  "hitGroups": [
+    {"name": "Ground", "type": "triangles", "closestHit": "MyClosestHitShader_Triangle"},
+    {"name": "Ground_Shadow", "type": "triangles"},
+    {"name": "Spheres", "type": "procedural", "intersection": "MyIntersectionShader_AnalyticPrimitive", "closestHit": "MyClosestHitShader_AABB"},
+    {"name": "Spheres_Shadow", "type": "procedural", "intersection": "MyIntersectionShader_AnalyticPrimitive"}
+  ],
+  "structs": {
+    "PrimitiveConstantBuffer": [
+      ["float4", "albedo"], ["float", "reflectanceCoef"], ["float", "diffuseCoef"], ["float", "specularCoef"],
+      ["float", "specularPower"], ["float", "stepScale"], ["float3", "padding"]
+    ],
+    "PrimitiveInstanceConstantBuffer": [["uint", "instanceIndex"], ["uint", "primitiveType"]]
+  },
+  "values": {
+    "ground": {"albedo": [0.9, 0.9, 0.9, 1], "reflectanceCoef": 0.25, "diffuseCoef": 1, "specularCoef": 0.4, "specularPower": 50, "stepScale": 1},
+    "chrome": {"albedo": [0.549, 0.556, 0.554, 1], "reflectanceCoef": 1, "diffuseCoef": 0.9, "specularCoef": 0.7, "specularPower": 50, "stepScale": 1}
+  },
+  "rootSignatures": {
+    "global": {"name": "Global", "parameters": [
+      {"name": "g_renderTarget", "kind": "table", "ranges": [{"type": "UAV", "register": "u0"}]},
+      {"name": "g_scene", "kind": "srv", "register": "t0"},
+      {"name": "g_sceneCB", "kind": "cbv", "register": "b0"},
+      {"name": "g_AABBPrimitiveAttributes", "kind": "srv", "register": "t3"},
+      {"name": "g_vertexBuffers", "kind": "table", "ranges": [{"type": "SRV", "register": "t1", "count": 2}]}
+    ]},
+    "local": [
+      {"name": "Triangle", "parameters": [
+        {"name": "l_materialCB", "kind": "constants", "register": "b1", "struct": "PrimitiveConstantBuffer"}
+      ]},
+      {"name": "AABB", "parameters": [
+        {"name": "l_materialCB", "kind": "constants", "register": "b1", "struct": "PrimitiveConstantBuffer"},
+        {"name": "l_aabbCB", "kind": "constants", "register": "b2", "struct": "PrimitiveInstanceConstantBuffer"}
+      ]}
+    ]
+  },
+  "buffers": {
+    "planeIndices": {"format": "uint16", "data": [3, 1, 0, 2, 1, 3]},
+    "planeVertices": {"format": "float32", "stride": 24, "data": [
+      0, 0, 0,  0, 1, 0,
+      1, 0, 0,  0, 1, 0,
+      1, 0, 1,  0, 1, 0,
+      0, 0, 1,  0, 1, 0
+    ]},
+    "sceneCB": {"generate": "sceneConstants"},
+    "spheresTransform": {"generate": "primitiveTransforms", "blas": "SpheresBox", "elements": [
+      {"geometry": 0, "scale": [1.5, 1.5, 1.5], "spinYPerSecond": -2}
+    ]}
+  },
+  "bottomLevel": [
+    {"name": "Plane", "geometries": [
+      {"type": "triangles", "flags": ["OPAQUE"],
+       "vertices": {"buffer": "planeVertices", "stride": 24},
+       "indices": {"buffer": "planeIndices", "format": "R16_UINT"}}
+    ]},
+    {"name": "SpheresBox", "geometries": [
+      {"type": "aabbs", "flags": ["OPAQUE"], "aabbs": [[-1.5, 0, -1.5, 1.5, 3, 1.5]]}
+    ]}
+  ],
+  "instances": [
+    )";
+    if (l.ground) text += groundInstance;
+    text += R"({"name": "spheres", "blas": "SpheresBox", "mask": 1, "contribution": 2,
+     "transform": {"scale": )";
+    text += vec3Text(l.scale[0], l.scale[1], l.scale[2]);
+    text += R"(, "translate": )";
+    text += vec3Text(o[0], o[1], o[2]);
+    text += R"(}}
+  ],
+  "shaderTable": {
+    "miss": ["MyMissShader", "MyMissShader_ShadowRay"],
+    "hitGroups": [
+      {"hitGroup": "Ground", "localRootSignature": "Triangle", "arguments": {"l_materialCB": "ground"}},
+      {"hitGroup": "Ground_Shadow", "localRootSignature": "Triangle", "arguments": {"l_materialCB": "ground"}},
+      {"hitGroup": "Spheres", "localRootSignature": "AABB",
+       "arguments": {"l_materialCB": "chrome", "l_aabbCB": {"instanceIndex": 0, "primitiveType": 1}}},
+      {"hitGroup": "Spheres_Shadow", "localRootSignature": "AABB",
+       "arguments": {"l_materialCB": "chrome", "l_aabbCB": {"instanceIndex": 0, "primitiveType": 1}}}
+    ]
+  },
+  "globalArguments": {
+    "g_renderTarget": ["@renderTarget"],
+    "g_scene": "@tlas",
+    "g_sceneCB": "sceneCB",
+    "g_AABBPrimitiveAttributes": "spheresTransform",
+    "g_vertexBuffers": [{"buffer": "planeIndices"}, {"buffer": "planeVertices", "stride": 24}]
+  },
+  "cameras": [
+    {"name": "front", "model": "directxmath-lh", "eye": )";
+    text += vec3Text(l.eye[0] + o[0], l.eye[1] + o[1], l.eye[2] + o[2]);
+    text += R"(, "target": )";
+    text += vec3Text(l.target[0] + o[0], l.target[1] + o[1], l.target[2] + o[2]);
+    text += R"(, "up": [0, 1, 0],
+     "fovYDegrees": 45, "near": )";
+    text += num(l.nearPlane);
+    text += R"(, "far": )";
+    text += num(l.farPlane);
+    text += R"(}
+  ],
+  "light": {"position": )";
+    text += "[";
+    text += num(l.light[0] + o[0]);
+    text += ", ";
+    text += num(l.light[1] + o[1]);
+    text += ", ";
+    text += num(l.light[2] + o[2]);
+    text += ", 0]";
+    text += R"(, "ambientColor": [0.25, 0.25, 0.25, 1], "diffuseColor": [0.6, 0.6, 0.6, 1]}
+})";
+    return text;  // appended piece by piece: GCC 12's -Wrestrict misfires on chains of operator+
+}
+
+constexpr uint32_t kWidth = 96;
+constexpr uint32_t kHeight = 54;
+
+Image render(const Layout& layout, Precision precision) {
+    Scene scene(parseScene(sceneText(layout), "translated.json"));
+    RenderSettings s;
+    s.width = kWidth;
+    s.height = kHeight;
+    s.threads = 4;
+    s.precision = precision;
+    return scene.render(s).image;
+}
+
+// How far one render is from another, channel by channel (RGB, each clamped to [0, 1] as the UNORM target does).
+struct Difference {
+    double maxAbs = 0;
+    double shareOver1of255 = 0;  // of the pixels, those with a channel more than 1/255 off
+    double shareOver0p1 = 0;     // ... more than 0.1 off
+    size_t nonFinite = 0;        // channels of `actual` that are NaN or Inf
+    size_t objectPixels = 0;     // pixels not of the background colour in either image
+    size_t objectOver1of255 = 0;  // of those, how many are more than 1/255 off
+};
+
+// The miss shader's colour is a constant: the top-left pixel, which none of the scenes below cover.
+bool isBackground(const Image& image, uint32_t x, uint32_t y) {
+    const vec4 a = image.at(x, y), b = image.at(0, 0);
+    return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
+}
+
+Difference compare(const Image& expected, const Image& actual) {
+    Difference d;
+    size_t over1of255 = 0, over0p1 = 0;
+    for (uint32_t y = 0; y < expected.height(); ++y)
+        for (uint32_t x = 0; x < expected.width(); ++x) {
+            double worst = 0;
+            for (int c = 0; c < 3; ++c) {
+                const float a = actual.at(x, y)[c];
+                if (!std::isfinite(a)) {
+                    ++d.nonFinite;
+                    worst = 1;
+                    continue;
+                }
+                const double e = std::clamp(double(expected.at(x, y)[c]), 0.0, 1.0);
+                worst = std::max(worst, std::abs(std::clamp(double(a), 0.0, 1.0) - e));
+            }
+            d.maxAbs = std::max(d.maxAbs, worst);
+            if (!isBackground(expected, x, y) || !isBackground(actual, x, y)) {
+                ++d.objectPixels;
+                d.objectOver1of255 += worst > 1.0 / 255.0;
+            }
+            over1of255 += worst > 1.0 / 255.0;
+            over0p1 += worst > 0.1;
+        }
+    const double pixels = double(expected.width()) * expected.height();
+    d.shareOver1of255 = double(over1of255) / pixels;
+    d.shareOver0p1 = double(over0p1) / pixels;
+    return d;
+}
+
+const char* name(Precision precision) { return precision == Precision::Float ? "float" : "double"; }
+
+// Renders `base` at offset 0 and at each D of `offsets` (offset (D, D/2, -D)), prints one line per offset and
+// returns the differences, in the order of `offsets`.
+std::vector<Difference> sweep(const char* label, Layout base, Precision precision, const std::vector<double>& offsets) {
+    const Image reference = render(base, precision);
+    std::vector<Difference> out;
+    for (const double D : offsets) {
+        base.offset[0] = D;
+        base.offset[1] = D / 2;
+        base.offset[2] = -D;
+        const Difference d = compare(reference, render(base, precision));
+        std::printf("[translation] %s %s D=%.0e: max |diff| %.4f, pixels > 1/255 %.1f%%, > 0.1 %.1f%%, non-finite %zu; "
+                    "object pixels %zu, of them > 1/255 %zu\n",
+                    label, name(precision), D, d.maxAbs, 100 * d.shareOver1of255, 100 * d.shareOver0p1, d.nonFinite,
+                    d.objectPixels, d.objectOver1of255);
+        out.push_back(d);
+    }
+    return out;
+}
+
+const std::vector<double> kOffsets = {1e3, 1e4, 1e5};
+
+// Why the image is not invariant. The ray generation shader unprojects each pixel at the near plane (z = 0) through
+// projectionToWorld, which the scene constants hold in float: the homogeneous point is about eye / near, so after
+// the divide by w the near-plane point carries an error of about ulp(|eye|) and the direction
+// normalize(point - eye), a vector of length ~near, turns by about ulp(|eye|) / near radians. With near = 0.01, a
+// 45 degree field of view and 54 rows (0.0145 rad a pixel) that is 6.1e-5 / 0.01 = 0.006 rad = 0.4 pixel at
+// D = 1e3, 4 pixels at 1e4 and 40 pixels at 1e5; the rounding of the matrix is in the constants, so double
+// shaders do not remove it. Silhouettes and the chrome's reflections move by that much, so even D = 1e3 is not
+// identical: only there do the differences stay a one-pixel fringe, which is the stated bound.
+constexpr double kBoundMaxAbsAt1e3 = 0.35;   // measured 0.26 to 0.33: a pixel of sphere against background or ground
+constexpr double kBoundShareOver0p1At1e3 = 0.02;  // measured 0.2% (spheres) and 0.5% to 1.3% (with the ground)
+
+void expectWithinTheBoundAt1e3(const Difference& d) {
+    EXPECT_LE(d.maxAbs, kBoundMaxAbsAt1e3);
+    EXPECT_LE(d.shareOver0p1, kBoundShareOver0p1At1e3);
+}
+
+TEST(Translation, GroundAndSpheresStayWithinAPixelFringeAt1e3AndFiniteInDoubleTo1e5) {
+    for (const Precision precision : {Precision::Float, Precision::Double}) {
+        const std::vector<Difference> d = sweep("ground+spheres", Layout{}, precision, kOffsets);
+        expectWithinTheBoundAt1e3(d[0]);
+        EXPECT_EQ(d[0].nonFinite, 0u);
+        // TODO(issue 6): with float shaders the ground renders NaN from D = 1e4 on (7668 channels at 1e4, 12579 at
+        // 1e5, measured); printed above, not yet asserted.
+        if (precision == Precision::Double) {
+            for (const Difference& x : d) EXPECT_EQ(x.nonFinite, 0u);
+        }
+    }
+}
+
+TEST(Translation, SpheresAloneStayWithinAPixelFringeAt1e3AndFiniteTo1e5) {
+    Layout l;
+    l.ground = false;
+    for (const Precision precision : {Precision::Float, Precision::Double}) {
+        const std::vector<Difference> d = sweep("spheres", l, precision, kOffsets);
+        expectWithinTheBoundAt1e3(d[0]);
+        for (const Difference& x : d) EXPECT_EQ(x.nonFinite, 0u);
+    }
+}
+
+}  // namespace
+}  // namespace refray::scenes
