@@ -13,6 +13,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -57,131 +60,59 @@ struct Layout {
     bool ground = true;
 };
 
+// `text` with `from` replaced by `to`; `from` must occur exactly once.
+std::string replacedOnce(std::string text, const std::string& from, const std::string& to) {
+    const size_t at = text.find(from);
+    if (at == std::string::npos || text.find(from, at + 1) != std::string::npos) {
+        std::string message = "the scene text does not hold exactly one '";
+        message += from;
+        message += "'";
+        throw std::runtime_error(message);
+    }
+    return text.replace(at, from.size(), to);
+}
+
+// The scene-format example in explicit layout (tests/scenes/data/ground-and-spheres-explicit.json) with every
+// world position moved by the layout's offset, the spheres' instance scaled, and the camera and light of `l`.
 std::string sceneText(const Layout& l) {
+    static const std::string base = [] {
+        std::ifstream in(std::string(REFRAY_SOURCE_DIR) + "/tests/scenes/data/ground-and-spheres-explicit.json");
+        return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }();
     const double* o = l.offset;
-    std::string groundInstance = R"({"name": "ground", "blas": "Plane", "mask": 1, "transform": {"scale": [40, 1, 40], "translate": )";
-    groundInstance += vec3Text(-20 + o[0], o[1], -20 + o[2]);
-    groundInstance += R"(}, "contribution": 0},
-    )";
-    std::string text = R"({
-  "format": "refray-scene/1",
-  "name": "translated-ground-and-spheres",
-  "shaderLibrary": "d3d12-procedural-geometry",
-  "layout": "explicit",
-  "pipeline": {"rayGeneration": "MyRaygenShader", "maxRecursionDepth": 3, "maxPayloadBytes": 20, "maxAttributeBytes": 12},
-  "rayTypes": [
-    {"name": "Radiance", "miss": "MyMissShader", "payload": "RayPayload"},
-    {"name": "Shadow", "miss": "MyMissShader_ShadowRay", "payload": "ShadowRayPayload"}
-  ],
-  "hitGroups": [
-    {"name": "Ground", "type": "triangles", "closestHit": "MyClosestHitShader_Triangle"},
-    {"name": "Ground_Shadow", "type": "triangles"},
-    {"name": "Spheres", "type": "procedural", "intersection": "MyIntersectionShader_AnalyticPrimitive", "closestHit": "MyClosestHitShader_AABB"},
-    {"name": "Spheres_Shadow", "type": "procedural", "intersection": "MyIntersectionShader_AnalyticPrimitive"}
-  ],
-  "structs": {
-    "PrimitiveConstantBuffer": [
-      ["float4", "albedo"], ["float", "reflectanceCoef"], ["float", "diffuseCoef"], ["float", "specularCoef"],
-      ["float", "specularPower"], ["float", "stepScale"], ["float3", "padding"]
-    ],
-    "PrimitiveInstanceConstantBuffer": [["uint", "instanceIndex"], ["uint", "primitiveType"]]
-  },
-  "values": {
-    "ground": {"albedo": [0.9, 0.9, 0.9, 1], "reflectanceCoef": 0.25, "diffuseCoef": 1, "specularCoef": 0.4, "specularPower": 50, "stepScale": 1},
-    "chrome": {"albedo": [0.549, 0.556, 0.554, 1], "reflectanceCoef": 1, "diffuseCoef": 0.9, "specularCoef": 0.7, "specularPower": 50, "stepScale": 1}
-  },
-  "rootSignatures": {
-    "global": {"name": "Global", "parameters": [
-      {"name": "g_renderTarget", "kind": "table", "ranges": [{"type": "UAV", "register": "u0"}]},
-      {"name": "g_scene", "kind": "srv", "register": "t0"},
-      {"name": "g_sceneCB", "kind": "cbv", "register": "b0"},
-      {"name": "g_AABBPrimitiveAttributes", "kind": "srv", "register": "t3"},
-      {"name": "g_vertexBuffers", "kind": "table", "ranges": [{"type": "SRV", "register": "t1", "count": 2}]}
-    ]},
-    "local": [
-      {"name": "Triangle", "parameters": [
-        {"name": "l_materialCB", "kind": "constants", "register": "b1", "struct": "PrimitiveConstantBuffer"}
-      ]},
-      {"name": "AABB", "parameters": [
-        {"name": "l_materialCB", "kind": "constants", "register": "b1", "struct": "PrimitiveConstantBuffer"},
-        {"name": "l_aabbCB", "kind": "constants", "register": "b2", "struct": "PrimitiveInstanceConstantBuffer"}
-      ]}
-    ]
-  },
-  "buffers": {
-    "planeIndices": {"format": "uint16", "data": [3, 1, 0, 2, 1, 3]},
-    "planeVertices": {"format": "float32", "stride": 24, "data": [
-      0, 0, 0,  0, 1, 0,
-      1, 0, 0,  0, 1, 0,
-      1, 0, 1,  0, 1, 0,
-      0, 0, 1,  0, 1, 0
-    ]},
-    "sceneCB": {"generate": "sceneConstants"},
-    "spheresTransform": {"generate": "primitiveTransforms", "blas": "SpheresBox", "elements": [
-      {"geometry": 0, "scale": [1.5, 1.5, 1.5], "spinYPerSecond": -2}
-    ]}
-  },
-  "bottomLevel": [
-    {"name": "Plane", "geometries": [
-      {"type": "triangles", "flags": ["OPAQUE"],
-       "vertices": {"buffer": "planeVertices", "stride": 24},
-       "indices": {"buffer": "planeIndices", "format": "R16_UINT"}}
-    ]},
-    {"name": "SpheresBox", "geometries": [
-      {"type": "aabbs", "flags": ["OPAQUE"], "aabbs": [[-1.5, 0, -1.5, 1.5, 3, 1.5]]}
-    ]}
-  ],
-  "instances": [
-    )";
-    if (l.ground) text += groundInstance;
-    text += R"({"name": "spheres", "blas": "SpheresBox", "mask": 1, "contribution": 2,
-     "transform": {"scale": )";
-    text += vec3Text(l.scale[0], l.scale[1], l.scale[2]);
-    text += R"(, "translate": )";
-    text += vec3Text(o[0], o[1], o[2]);
-    text += R"(}}
-  ],
-  "shaderTable": {
-    "miss": ["MyMissShader", "MyMissShader_ShadowRay"],
-    "hitGroups": [
-      {"hitGroup": "Ground", "localRootSignature": "Triangle", "arguments": {"l_materialCB": "ground"}},
-      {"hitGroup": "Ground_Shadow", "localRootSignature": "Triangle", "arguments": {"l_materialCB": "ground"}},
-      {"hitGroup": "Spheres", "localRootSignature": "AABB",
-       "arguments": {"l_materialCB": "chrome", "l_aabbCB": {"instanceIndex": 0, "primitiveType": 1}}},
-      {"hitGroup": "Spheres_Shadow", "localRootSignature": "AABB",
-       "arguments": {"l_materialCB": "chrome", "l_aabbCB": {"instanceIndex": 0, "primitiveType": 1}}}
-    ]
-  },
-  "globalArguments": {
-    "g_renderTarget": ["@renderTarget"],
-    "g_scene": "@tlas",
-    "g_sceneCB": "sceneCB",
-    "g_AABBPrimitiveAttributes": "spheresTransform",
-    "g_vertexBuffers": [{"buffer": "planeIndices"}, {"buffer": "planeVertices", "stride": 24}]
-  },
-  "cameras": [
-    {"name": "front", "model": "directxmath-lh", "eye": )";
-    text += vec3Text(l.eye[0] + o[0], l.eye[1] + o[1], l.eye[2] + o[2]);
-    text += R"(, "target": )";
-    text += vec3Text(l.target[0] + o[0], l.target[1] + o[1], l.target[2] + o[2]);
-    text += R"(, "up": [0, 1, 0],
-     "fovYDegrees": 45, "near": )";
-    text += num(l.nearPlane);
-    text += R"(, "far": )";
-    text += num(l.farPlane);
-    text += R"(}
-  ],
-  "light": {"position": )";
-    text += "[";
-    text += num(l.light[0] + o[0]);
-    text += ", ";
-    text += num(l.light[1] + o[1]);
-    text += ", ";
-    text += num(l.light[2] + o[2]);
-    text += ", 0]";
-    text += R"(, "ambientColor": [0.25, 0.25, 0.25, 1], "diffuseColor": [0.6, 0.6, 0.6, 1]}
-})";
-    return text;  // appended piece by piece: GCC 12's -Wrestrict misfires on chains of operator+
+    std::string text = replacedOnce(base, "\"ground-and-spheres\"", "\"translated-ground-and-spheres\"");
+    std::string ground;
+    if (l.ground) {
+        ground = "    {\"name\": \"ground\", \"blas\": \"Plane\", \"mask\": 1,\n     \"transform\": {\"scale\": [40, 1, 40], "
+                 "\"translate\": ";
+        ground += vec3Text(-20 + o[0], o[1], -20 + o[2]);
+        ground += "}, \"contribution\": 0},\n";
+    }
+    text = replacedOnce(text,
+                        "    {\"name\": \"ground\", \"blas\": \"Plane\", \"mask\": 1,\n     \"transform\": {\"scale\": [40, 1, "
+                        "40], \"translate\": [-20, 0, -20]}, \"contribution\": 0},\n",
+                        ground);
+    std::string spheres = "\"contribution\": 2, \"transform\": {\"scale\": ";
+    spheres += vec3Text(l.scale[0], l.scale[1], l.scale[2]);
+    spheres += ", \"translate\": ";
+    spheres += vec3Text(o[0], o[1], o[2]);
+    spheres += "}}";
+    text = replacedOnce(text, "\"contribution\": 2}", spheres);
+    std::string camera = "\"eye\": ";
+    camera += vec3Text(l.eye[0] + o[0], l.eye[1] + o[1], l.eye[2] + o[2]);
+    camera += ", \"target\": ";
+    camera += vec3Text(l.target[0] + o[0], l.target[1] + o[1], l.target[2] + o[2]);
+    text = replacedOnce(text, "\"eye\": [0, 4, -9], \"target\": [0, 1.5, 0]", camera);
+    std::string planes = "\"near\": ";
+    planes += num(l.nearPlane);
+    planes += ", \"far\": ";
+    planes += num(l.farPlane);
+    text = replacedOnce(text, "\"near\": 0.01, \"far\": 125", planes);
+    std::string light = "\"position\": ";
+    light += vec3Text(l.light[0] + o[0], l.light[1] + o[1], l.light[2] + o[2]);
+    light.back() = ',';
+    light += " 0]";
+    return replacedOnce(text, "\"position\": [0, 18, -20, 0]", light);
 }
 
 constexpr uint32_t kWidth = 96;
