@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "core/error.h"
+#include "core/strings.h"
 #include "scenes/scene_loader.h"
 
 namespace refray::scenes {
@@ -34,6 +35,40 @@ std::pair<Float4x4, Float4x4> primitiveTransform(const PrimitiveTransformDesc& p
         Ti[3][size_t(k)] = -double(p.centre[k]);
     }
     return {toFloat4x4(multiply(multiply(S, R), T)), toFloat4x4(multiply(multiply(Ti, Rt), Si))};
+}
+
+// A shader that writes NaN or Inf into the render target breaks no DXR rule, but the pixel is lost (an
+// R8G8B8A8_UNORM target stores 0): a warning (GEN-4) with the count and the first such launch index, in row order.
+void reportNonFinitePixels(const Image& target, const RenderSettings& settings, DiagnosticLog& log) {
+    uint32_t x0 = 0, y0 = 0, x1 = target.width(), y1 = target.height();
+    if (settings.region) {
+        x0 = settings.region->x, y0 = settings.region->y;
+        x1 = x0 + settings.region->width, y1 = y0 + settings.region->height;
+    }
+    uint64_t count = 0;
+    uvec2 first(0u);
+    for (uint32_t y = y0; y < y1; ++y)
+        for (uint32_t x = x0; x < x1; ++x) {
+            const vec4& p = target.at(x, y);
+            if (std::isfinite(p.r) && std::isfinite(p.g) && std::isfinite(p.b) && std::isfinite(p.a)) continue;
+            if (count++ == 0) first = uvec2(x, y);
+        }
+    if (count == 0) return;
+    const vec4& p = target.at(first.x, first.y);
+    std::string where = std::to_string(first.x);
+    where += ",";
+    where += std::to_string(first.y);
+    std::string value = "(";
+    for (int c = 0; c < 4; ++c) {
+        if (c) value += ", ";
+        value += shortestFloat(p[c]);
+    }
+    value += ")";
+    log.add(warning("GEN-4", "the shaders wrote NaN or Inf to the render target; an R8G8B8A8_UNORM target stores 0 "
+                             "there (refray explain --pixel shows the rays of the first)")
+                .value("pixels", count)
+                .value("first launch index", where)
+                .value("its value", value));
 }
 
 uint32_t sampleGridSize(uint32_t spp) {
@@ -244,6 +279,7 @@ RenderResult Scene::render(const RenderSettings& settings) {
     desc.Depth = 1;
     RenderResult result;
     result.dispatch = dispatchWithSettings(device_, desc, pipeline.stateObject, &globals, settings);
+    reportNonFinitePixels(target, settings, result.dispatch.diagnostics);
 
     // k x k samples per output pixel, averaged in float in a fixed order (deterministic).
     if (k == 1) {
