@@ -50,6 +50,24 @@ std::string joined(const std::vector<std::string>& names, std::string_view separ
     return out;
 }
 
+std::string inQuotes(std::string_view text) {
+    std::string out = "'";
+    out += text;
+    out += '\'';
+    return out;
+}
+
+std::string hexText(uint64_t value, int digits) {
+    char text[24];
+    std::snprintf(text, sizeof text, "0x%0*llX", digits, static_cast<unsigned long long>(value));
+    return text;
+}
+
+std::string withoutNamespace(std::string_view qualified) {
+    const size_t colon = qualified.rfind("::");
+    return std::string(colon == std::string_view::npos ? qualified : qualified.substr(colon + 2));
+}
+
 std::string htmlEscape(std::string_view text) {
     std::string out;
     for (const char c : text) {

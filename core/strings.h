@@ -1,6 +1,7 @@
 // Small string helpers shared by the layers: "did you mean" suggestions.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -19,6 +20,13 @@ std::string didYouMean(std::string_view name, const std::vector<std::string>& ca
 
 // "a, b, c".
 std::string joined(const std::vector<std::string>& names, std::string_view separator = ", ");
+
+// "'text'": how messages and tables quote names.
+std::string inQuotes(std::string_view text);
+// "0x1F00": upper-case hex, zero-padded to at least `digits` digits.
+std::string hexText(uint64_t value, int digits = 0);
+// "Name" of "a::b::Name" (a demangled C++ type as scene files write it).
+std::string withoutNamespace(std::string_view qualified);
 
 // `text` with &, <, >, " and ' escaped for HTML.
 std::string htmlEscape(std::string_view text);

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "core/strings.h"
+
 namespace refray::dxr {
 
 std::string Diagnostic::format() const {
@@ -86,9 +88,7 @@ DiagnosticBuilder::DiagnosticBuilder(std::string ruleId, std::string message, Se
 }
 
 DiagnosticBuilder& DiagnosticBuilder::hex(std::string name, uint64_t v, std::string limit) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "0x%llX", static_cast<unsigned long long>(v));
-    diagnostic_.values.push_back({std::move(name), buf, std::move(limit)});
+    diagnostic_.values.push_back({std::move(name), hexText(v), std::move(limit)});
     return *this;
 }
 

@@ -154,10 +154,6 @@ const std::vector<PayloadLayout>& payloadLayouts() {
     return layouts;
 }
 
-std::string shortTypeName(const std::string& name) {
-    const size_t colon = name.rfind("::");
-    return colon == std::string::npos ? name : name.substr(colon + 2);
-}
 
 std::string formatWord(uint32_t word, char kind) {
     switch (kind) {
@@ -172,11 +168,6 @@ std::string formatWord(uint32_t word, char kind) {
     }
 }
 
-std::string hex(uint64_t value) {
-    char text[24];
-    std::snprintf(text, sizeof text, "0x%" PRIX64, value);
-    return text;
-}
 
 std::string vec3Text(const vec3& v) {
     return "(" + shortestFloat(v.x) + ", " + shortestFloat(v.y) + ", " + shortestFloat(v.z) + ")";
@@ -207,7 +198,7 @@ std::string describePayload(const std::string& typeName, const std::vector<uint8
     }
     for (size_t i = 0; i < words.size(); ++i) {
         if (i) out += " ";
-        out += hex(words[i]);
+        out += hexText(words[i]);
     }
     return out;
 }
@@ -275,7 +266,7 @@ std::string formatExplanation(const Explanation& x, const SceneDesc& scene) {
             case Kind::ShaderCall: {
                 const std::string stage(dxr::toString(e.stage));
                 if (e.stage == dxr::ShaderStage::RayGeneration) {
-                    w.line(0, stage + " shader '" + r.exportName + "' (ray generation record at " + hex(e.recordAddress) + ")");
+                    w.line(0, stage + " shader '" + r.exportName + "' (ray generation record at " + hexText(e.recordAddress) + ")");
                 } else {
                     w.line(base + 1, stage + " shader '" + r.exportName + "' runs (record " + std::to_string(e.recordIndex) + ")");
                 }
@@ -290,7 +281,7 @@ std::string formatExplanation(const Explanation& x, const SceneDesc& scene) {
                                  shortestFloat(e.ray.TMin) + "  TMax " + shortestFloat(e.ray.TMax));
                 std::string flags = "RayFlags " + dxr::rayFlagsToString(e.rayFlags);
                 if (e.effectiveFlags != e.rayFlags) flags += " (with the pipeline's: " + dxr::rayFlagsToString(e.effectiveFlags) + ")";
-                w.line(base, flags + "  InstanceInclusionMask " + hex(e.instanceInclusionMask));
+                w.line(base, flags + "  InstanceInclusionMask " + hexText(e.instanceInclusionMask));
                 w.line(base, "RayContributionToHitGroupIndex R = " + std::to_string(e.rayContribution) +
                                  ", MultiplierForGeometryContributionToHitGroupIndex M = " + std::to_string(e.multiplier) +
                                  ", MissShaderIndex = " + std::to_string(e.missShaderIndex));
@@ -298,9 +289,9 @@ std::string formatExplanation(const Explanation& x, const SceneDesc& scene) {
                     const uint32_t both = scene.instances[i].mask & e.instanceInclusionMask & 0xFF;
                     if (both == 0)
                         w.line(base, "masked out: instance " + std::to_string(i) + " '" + scene.instances[i].name +
-                                         "' (InstanceMask " + hex(scene.instances[i].mask) + " & InstanceInclusionMask & 0xFF = 0, INST-4)");
+                                         "' (InstanceMask " + hexText(scene.instances[i].mask) + " & InstanceInclusionMask & 0xFF = 0, INST-4)");
                 }
-                w.line(base, "payload in: " + shortTypeName(r.payloadType) + " {" + describePayload(r.payloadType, r.payload) + "}");
+                w.line(base, "payload in: " + withoutNamespace(r.payloadType) + " {" + describePayload(r.payloadType, r.payload) + "}");
                 break;
             }
             case Kind::Candidate:
@@ -312,14 +303,14 @@ std::string formatExplanation(const Explanation& x, const SceneDesc& scene) {
                 std::string text;
                 if (e.hasTerms) {
                     text = "hit-group record: " + termsText(e.terms) + "; address = StartAddress + " + std::to_string(e.stride) +
-                           "×" + std::to_string(e.recordIndex) + " = " + hex(e.recordAddress);
+                           "×" + std::to_string(e.recordIndex) + " = " + hexText(e.recordAddress);
                 } else if (r.table == "ray generation record") {
-                    text = "ray generation record at " + hex(e.recordAddress);
+                    text = "ray generation record at " + hexText(e.recordAddress);
                 } else {
                     text = r.table + " record " + std::to_string(e.recordIndex);
                     if (r.table == "miss shader table") text += " (MissShaderIndex & 0xFFFF)";
                     text += "; address = StartAddress + " + std::to_string(e.stride) + "×" + std::to_string(e.recordIndex) +
-                            " = " + hex(e.recordAddress);
+                            " = " + hexText(e.recordAddress);
                 }
                 if (r.note == "NULL") text += ": NULL (no shader runs, REC-8)";
                 else if (r.note == "invalid") text += ": invalid (see the error below)";
@@ -340,7 +331,7 @@ std::string formatExplanation(const Explanation& x, const SceneDesc& scene) {
                 w.line(base, "result of TraceRay #" + std::to_string(number) + ": " +
                                  (e.committed ? "hit " + hitText(scene, e) + " at t = " + shortestFloat(e.t) : std::string("miss")) +
                                  (r.note.empty() ? "" : "; " + r.note));
-                w.line(base, "payload out: " + shortTypeName(r.payloadType) + " {" + describePayload(r.payloadType, r.payload) + "}");
+                w.line(base, "payload out: " + withoutNamespace(r.payloadType) + " {" + describePayload(r.payloadType, r.payload) + "}");
                 break;
             }
         }

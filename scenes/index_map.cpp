@@ -7,6 +7,7 @@
 
 #include "core/draw.h"
 #include "core/error.h"
+#include "core/strings.h"
 
 namespace refray::scenes {
 
@@ -82,7 +83,6 @@ vec4 depthColour(int64_t depth, int64_t deepest) {
     return vec4(t < 0.5f ? glm::mix(a, b, t * 2.0f) : glm::mix(b, c, t * 2.0f - 1.0f), 1.0f);
 }
 
-std::string quoted(const std::string& s) { return "'" + s + "'"; }
 
 }  // namespace
 
@@ -130,8 +130,8 @@ IndexMap renderIndexMap(Scene& scene, const RenderSettings& settings, IndexMapKi
                     break;
                 case IndexMapKind::Instance:
                     value = p.instanceIndex;
-                    label = "instance " + std::to_string(p.instanceIndex) + " " + quoted(inst.name) + " (BLAS " +
-                            quoted(desc.blases.at(inst.blas).name) + ", InstanceContribution " + std::to_string(inst.contribution) + ")";
+                    label = "instance " + std::to_string(p.instanceIndex) + " " + inQuotes(inst.name) + " (BLAS " +
+                            inQuotes(desc.blases.at(inst.blas).name) + ", InstanceContribution " + std::to_string(inst.contribution) + ")";
                     break;
                 case IndexMapKind::Geometry:
                     value = p.geometryIndex;

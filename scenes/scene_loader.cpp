@@ -20,7 +20,6 @@ namespace {
 using json::ObjectReader;
 using json::Value;
 
-std::string inQuotes(const std::string& s) { return "'" + s + "'"; }
 
 // An index into `names` for the string `value`, or an error at its location with a "did you mean".
 uint32_t resolveName(const Value& value, const std::vector<std::string>& names, const std::string& kind) {
@@ -307,8 +306,7 @@ private:
             const dxr::ShaderExport& e = requireExport(miss, dxr::ShaderStage::Miss);
             const Value& payload = r.required("payload");
             t.payload = payload.asString();
-            std::string declared = e.payload.name();
-            if (const size_t colon = declared.rfind("::"); colon != std::string::npos) declared = declared.substr(colon + 2);
+            const std::string declared = withoutNamespace(e.payload.name());
             if (declared != t.payload)
                 payload.fail("ray type " + inQuotes(t.name) + " says its payload is " + inQuotes(t.payload) +
                              ", but its miss shader " + inQuotes(t.miss) + " takes " + inQuotes(declared));

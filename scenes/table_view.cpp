@@ -7,6 +7,7 @@
 #include <map>
 
 #include "core/error.h"
+#include "core/strings.h"
 #include "emulator/device.h"
 #include "scenes/scene.h"
 
@@ -16,18 +17,7 @@ using namespace refray::dxr;
 
 namespace {
 
-std::string quote(const std::string& name) {
-    std::string out = "'";
-    out += name;
-    out += '\'';
-    return out;
-}
 
-std::string hex(uint64_t value, int digits = 0) {
-    char text[24];
-    std::snprintf(text, sizeof text, "0x%0*llX", digits, static_cast<unsigned long long>(value));
-    return text;
-}
 
 std::string floatText(uint32_t bits) {
     float f = 0.0f;
@@ -42,9 +32,7 @@ std::string floatText(uint32_t bits) {
 // The payload struct's name without namespaces, as scene files write it.
 std::string payloadName(const TypeTag& tag) {
     if (!tag.valid()) return "";
-    std::string name = tag.name();
-    if (const size_t colon = name.rfind("::"); colon != std::string::npos) name = name.substr(colon + 2);
-    return name;
+    return withoutNamespace(tag.name());
 }
 
 std::string registerName(const RootParameter& p) {
@@ -134,7 +122,7 @@ struct Reader {
         bool written = false;
         if (!readBytes(memory, r.address, kShaderIdentifierSizeInBytes, identifier, written)) {
             r.contents = RecordView::Contents::Unknown;
-            r.unknown = "no GPU buffer at " + hex(r.address);
+            r.unknown = "no GPU buffer at " + hexText(r.address);
             return r;
         }
         if (!written) {
@@ -265,7 +253,7 @@ void checkRecord(const ShaderTableView& table, const RecordView& r, ProgramEntry
             return;
         case RecordView::Contents::Unknown:
             findings.add(Level::Error, "REC-8", what + " holds an identifier that is not an export of state object " +
-                                                    quote(pipeline) + ": it is " + r.unknown);
+                                                    inQuotes(pipeline) + ": it is " + r.unknown);
             return;
         case RecordView::Contents::Export: break;
     }
@@ -275,7 +263,7 @@ void checkRecord(const ShaderTableView& table, const RecordView& r, ProgramEntry
     }
     const std::string sizes = std::to_string(r.layoutSize) + " bytes (REC-5)";
     std::string needs = r.describe();
-    if (!r.localRootSignature.empty()) needs += " with local root signature " + quote(r.localRootSignature);
+    if (!r.localRootSignature.empty()) needs += " with local root signature " + inQuotes(r.localRootSignature);
     if (table.strideInBytes != 0 && table.strideInBytes < r.layoutSize) {
         findings.add(Level::Error, "IDX-10", "the " + table.name + " stride (" + std::to_string(table.strideInBytes) +
                                                  ") is smaller than " + what + ": " + needs + " needs " + sizes);
@@ -321,7 +309,7 @@ std::string RecordView::describe() const {
         case Contents::Unknown: return "an unknown identifier";
         case Contents::Export: break;
     }
-    return kind + " " + quote(exportName);
+    return kind + " " + inQuotes(exportName);
 }
 
 std::string ReachView::equation() const {
@@ -362,7 +350,7 @@ const ReachView& TableView::reach(const std::string& instance, uint32_t geometry
     for (const ReachView& r : reachability)
         if (instances[r.instanceIndex].name == instance && r.geometryIndex == geometry && rayTypes[r.rayType].name == rayType)
             return r;
-    throw Error("no instance " + quote(instance) + " geometry " + std::to_string(geometry) + " ray type " + quote(rayType));
+    throw Error("no instance " + inQuotes(instance) + " geometry " + std::to_string(geometry) + " ray type " + inQuotes(rayType));
 }
 
 // ---- the view
@@ -404,7 +392,7 @@ TableView buildTableView(Scene& scene, procedural::Precision precision) {
         v.name = desc.blases[b].name;
         v.address = scene.blasAddress(b);
         const BottomLevelAS* blas = device.findBottomLevelAS(v.address);
-        REFRAY_ASSERT(blas, "BLAS '" << v.name << "' is not at " << hex(v.address));
+        REFRAY_ASSERT(blas, "BLAS '" << v.name << "' is not at " << hexText(v.address));
         for (size_t g = 0; g < blas->geometries().size(); ++g) {
             const BuiltGeometry& built = blas->geometries()[g];
             v.geometries.push_back({uint32_t(g), built.type == GeometryType::Triangles ? "triangles" : "AABBs", built.flags,
@@ -419,7 +407,7 @@ TableView buildTableView(Scene& scene, procedural::Precision precision) {
         const RayTypeDesc& d = desc.rayTypes[t];
         RayTypeView v{uint32_t(t), d.name, d.payload, d.rayContribution, d.multiplier, d.missShaderIndex,
                       d.instanceInclusionMask, -1, ""};
-        const std::string who = "ray type " + quote(d.name);
+        const std::string who = "ray type " + inQuotes(d.name);
         if (d.rayContribution > kRayContributionMask)
             findings.add(Level::Warning, "IDX-2", who + ": RayContributionToHitGroupIndex " + std::to_string(d.rayContribution) +
                                                       " keeps only its low 4 bits: R = " +
@@ -447,15 +435,15 @@ TableView buildTableView(Scene& scene, procedural::Precision precision) {
                              who + ": miss record " + std::to_string(index) + " is NULL: a miss runs no shader");
             else if (r.kind == toString(ProgramEntry::Kind::Miss) && r.payload != d.payload)
                 findings.add(Level::Error, "PAY-1", who + ": miss record " + std::to_string(index) + " holds " + r.describe() +
-                                                        ", which takes payload " + quote(r.payload) + ", not the ray type's " +
-                                                        quote(d.payload));
+                                                        ", which takes payload " + inQuotes(r.payload) + ", not the ray type's " +
+                                                        inQuotes(d.payload));
         }
         view.rayTypes.push_back(std::move(v));
     }
 
     // Instances: the TLAS's instance descs, bit for bit (INST-1).
     const TopLevelAS* tlas = device.findTopLevelAS(scene.tlas());
-    REFRAY_ASSERT(tlas, "the scene's TLAS is not at " << hex(scene.tlas()));
+    REFRAY_ASSERT(tlas, "the scene's TLAS is not at " << hexText(scene.tlas()));
     std::vector<bool> traversed;
     for (size_t i = 0; i < tlas->instances().size(); ++i) {
         const BuiltInstance& built = tlas->instances()[i];
@@ -471,7 +459,7 @@ TableView buildTableView(Scene& scene, procedural::Precision precision) {
         for (size_t b = 0; b < view.blases.size(); ++b)
             if (view.blases[b].address == v.blasAddress) v.blas = int32_t(b);
         traversed.push_back(built.blas != nullptr && v.blas >= 0);
-        const std::string who = "instance " + quote(v.name) + " (InstanceIndex " + std::to_string(i) + ")";
+        const std::string who = "instance " + inQuotes(v.name) + " (InstanceIndex " + std::to_string(i) + ")";
         if (v.blasAddress != 0 && !built.blas)
             findings.add(Level::Warning, "INST-9", who + " has a singular or non-finite transform and is never traversed");
         if (traversed.back())
@@ -479,8 +467,8 @@ TableView buildTableView(Scene& scene, procedural::Precision precision) {
                 const uint32_t inclusion = t.instanceInclusionMask & kInstanceInclusionMaskBits;
                 if ((v.instanceMask & inclusion) == 0)
                     findings.add(Level::Warning, "INST-4",
-                                 who + " is never hit by " + quote(t.name) + " rays: InstanceMask " + hex(v.instanceMask, 2) +
-                                     " & InstanceInclusionMask " + hex(inclusion, 2) + " = 0");
+                                 who + " is never hit by " + inQuotes(t.name) + " rays: InstanceMask " + hexText(v.instanceMask, 2) +
+                                     " & InstanceInclusionMask " + hexText(inclusion, 2) + " = 0");
             }
         view.instances.push_back(std::move(v));
     }
@@ -505,9 +493,9 @@ TableView buildTableView(Scene& scene, procedural::Precision precision) {
                 view.reachability.push_back(reach);
                 if (reach.maskedOut) continue;  // INST-4: reported once per instance and ray type
 
-                const std::string who = "instance " + quote(inst.name) + " (InstanceIndex " +
+                const std::string who = "instance " + inQuotes(inst.name) + " (InstanceIndex " +
                                         std::to_string(inst.instanceIndex) + "), geometry " +
-                                        std::to_string(g.geometryIndex) + ", ray type " + quote(t.name) +
+                                        std::to_string(g.geometryIndex) + ", ray type " + inQuotes(t.name) +
                                         ": I = R + M*G + C = " + reach.equation();
                 if (pastEnd) {
                     const HitGroupIndexTerms& terms = reach.terms;
@@ -540,11 +528,11 @@ TableView buildTableView(Scene& scene, procedural::Precision precision) {
                 }
                 if (!r.payload.empty() && r.payload != t.payload) {
                     const bool closestHit = !r.closestHit.empty();
-                    const std::string shader = closestHit ? "closest-hit shader " + quote(r.closestHit)
-                                                          : "any-hit shader " + quote(r.anyHit);
+                    const std::string shader = closestHit ? "closest-hit shader " + inQuotes(r.closestHit)
+                                                          : "any-hit shader " + inQuotes(r.anyHit);
                     findings.add(Level::Warning, "PAY-1",
                                  who + " selects " + r.describe() + ", whose " + shader + " takes payload " +
-                                     quote(r.payload) + ", not the ray type's " + quote(t.payload) + " (undefined if its " +
+                                     inQuotes(r.payload) + ", not the ray type's " + inQuotes(t.payload) + " (undefined if its " +
                                      (closestHit ? "closest-hit" : "any-hit") + " shader runs)");
                 }
             }

@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "core/json_writer.h"
+#include "core/strings.h"
 #include "scenes/scene.h"
 
 namespace refray::tools {
@@ -37,18 +38,7 @@ Exit status: 0; 1 with --check when there is an error; 2 when the scene cannot b
 // Argument lines longer than this wrap (the detail indent not counted).
 constexpr size_t kWrapColumn = 112;
 
-std::string hex(uint64_t value, int digits = 0) {
-    char text[24];
-    std::snprintf(text, sizeof text, "0x%0*llX", digits, static_cast<unsigned long long>(value));
-    return text;
-}
 
-std::string quote(const std::string& name) {
-    std::string out = "'";
-    out += name;
-    out += '\'';
-    return out;
-}
 
 std::string plural(uint64_t n, const char* one, const char* many) {
     std::string out = std::to_string(n);
@@ -131,10 +121,10 @@ std::string argumentText(const scenes::RootArgumentView& a, const scenes::Shader
         return out;
     }
     if (!a.written) return out + "never written";
-    if (a.kind == "descriptor table") return out + "handle " + hex(a.address);
-    out += hex(a.address);
+    if (a.kind == "descriptor table") return out + "handle " + hexText(a.address);
+    out += hexText(a.address);
     if (a.buffer.empty()) return out + " (no buffer there)";
-    out += " -> buffer " + quote(a.buffer);
+    out += " -> buffer " + inQuotes(a.buffer);
     if (a.bufferOffset) out += " + " + std::to_string(a.bufferOffset);
     return out;
 }
@@ -163,7 +153,7 @@ std::string shadersText(const scenes::RecordView& r) {
 void printTable(const scenes::ShaderTableView& t, std::string& out) {
     std::string title = t.name;
     title[0] = char(std::toupper(static_cast<unsigned char>(title[0])));
-    out += title + ": StartAddress " + hex(t.startAddress) + ", SizeInBytes " + std::to_string(t.sizeInBytes);
+    out += title + ": StartAddress " + hexText(t.startAddress) + ", SizeInBytes " + std::to_string(t.sizeInBytes);
     if (t.key != "rayGeneration") {
         uint32_t largest = 0;
         for (const scenes::RecordView& r : t.records) largest = std::max(largest, r.layoutSize);
@@ -174,7 +164,7 @@ void printTable(const scenes::ShaderTableView& t, std::string& out) {
     const bool hitGroups = t.key == "hitGroup";
     TextTable table({"record", "offset", "address", "holds", "local root signature"});
     for (const scenes::RecordView& r : t.records) {
-        table.row({std::to_string(r.index), std::to_string(r.offset), hex(r.address), holdsText(r),
+        table.row({std::to_string(r.index), std::to_string(r.offset), hexText(r.address), holdsText(r),
                    r.localRootSignature.empty() ? "-" : r.localRootSignature + " (" + std::to_string(r.layoutSize) + " bytes)"});
         if (r.contents == scenes::RecordView::Contents::Unknown) table.detail("it is " + r.unknown);
         if (hitGroups && r.contents == scenes::RecordView::Contents::Export) table.detail(shadersText(r));
@@ -264,8 +254,8 @@ void writeRecord(json::Writer& w, const scenes::RecordView& r) {
 
 std::string formatTableText(const TableView& v) {
     std::string out;
-    out += "Scene " + quote(v.scene) + ": shader library " + quote(v.shaderLibrary) + ", " + v.precision +
-           " shaders, state object " + quote(v.stateObject) + "\n";
+    out += "Scene " + inQuotes(v.scene) + ": shader library " + inQuotes(v.shaderLibrary) + ", " + v.precision +
+           " shaders, state object " + inQuotes(v.stateObject) + "\n";
     out += "A ray's hit-group record: I = R + M*G + C, address = HitGroupTable.StartAddress + StrideInBytes * I (IDX-1)\n\n";
 
     out += "Ray types (R, M, miss index and InstanceInclusionMask are the TraceRay arguments of their shaders)\n";
@@ -274,9 +264,9 @@ std::string formatTableText(const TableView& v) {
         rayTypes.row({std::to_string(t.index), t.name, t.payload, std::to_string(t.rayContribution),
                       std::to_string(t.multiplier), std::to_string(t.missShaderIndex),
                       t.missRecord < 0 ? t.missExport : std::to_string(t.missRecord) + ": " + t.missExport,
-                      t.instanceInclusionMask <= 0xFF ? hex(t.instanceInclusionMask, 2)
-                                                      : hex(t.instanceInclusionMask) + " (low 8 bits: " +
-                                                            hex(t.instanceInclusionMask & 0xFF, 2) + ")"});
+                      t.instanceInclusionMask <= 0xFF ? hexText(t.instanceInclusionMask, 2)
+                                                      : hexText(t.instanceInclusionMask) + " (low 8 bits: " +
+                                                            hexText(t.instanceInclusionMask & 0xFF, 2) + ")"});
     rayTypes.print(out);
 
     out += "\nInstances (TLAS instance descs; C = InstanceContributionToHitGroupIndex)\n";
@@ -284,8 +274,8 @@ std::string formatTableText(const TableView& v) {
     for (const scenes::InstanceView& i : v.instances) {
         const std::string blas = i.blas >= 0 ? v.blases[size_t(i.blas)].name
                                  : i.blasAddress == 0 ? std::string("(none: inactive)")
-                                                      : hex(i.blasAddress);
-        instances.row({std::to_string(i.instanceIndex), i.name, std::to_string(i.instanceID), hex(i.instanceMask, 2),
+                                                      : hexText(i.blasAddress);
+        instances.row({std::to_string(i.instanceIndex), i.name, std::to_string(i.instanceID), hexText(i.instanceMask, 2),
                        i.flagNames, std::to_string(i.contribution), blas});
     }
     instances.print(out);
@@ -294,7 +284,7 @@ std::string formatTableText(const TableView& v) {
     TextTable blases({"BLAS", "address", "G", "type", "flags", "primitives"});
     for (const scenes::BlasView& b : v.blases)
         for (const scenes::GeometryView& g : b.geometries)
-            blases.row({g.geometryIndex == 0 ? b.name : "", g.geometryIndex == 0 ? hex(b.address) : "",
+            blases.row({g.geometryIndex == 0 ? b.name : "", g.geometryIndex == 0 ? hexText(b.address) : "",
                         std::to_string(g.geometryIndex), g.type, g.flagNames, std::to_string(g.primitiveCount)});
     blases.print(out);
 
@@ -309,10 +299,10 @@ std::string formatTableText(const TableView& v) {
         const scenes::InstanceView& inst = v.instances[r.instanceIndex];
         std::string holds = r.holds;
         if (r.maskedOut)
-            holds = "(never traversed: InstanceMask " + hex(inst.instanceMask, 2) + " & InstanceInclusionMask " +
-                    hex(v.rayTypes[r.rayType].instanceInclusionMask & 0xFF, 2) + " = 0)";
+            holds = "(never traversed: InstanceMask " + hexText(inst.instanceMask, 2) + " & InstanceInclusionMask " +
+                    hexText(v.rayTypes[r.rayType].instanceInclusionMask & 0xFF, 2) + " = 0)";
         reach.row({std::to_string(r.instanceIndex), inst.name, std::to_string(r.geometryIndex), v.rayTypes[r.rayType].name,
-                   r.equation(), hex(r.address), holds});
+                   r.equation(), hexText(r.address), holds});
     }
     reach.print(out);
 

@@ -15,3 +15,12 @@ TEST(Strings, DidYouMeanSuggestsCloseNamesOnly) {
     EXPECT_EQ(didYouMean("ClosestHit_Pacmn", names), " (did you mean 'ClosestHit_Pacman'?)");
     EXPECT_EQ(didYouMean("SomethingElseEntirely", names), "");
 }
+
+TEST(Strings, QuotesHexAndNamespaces) {
+    EXPECT_EQ(inQuotes("HitGroup_Pacman"), "'HitGroup_Pacman'");
+    EXPECT_EQ(hexText(0xE0F80), "0xE0F80");
+    EXPECT_EQ(hexText(0x1F, 4), "0x001F");
+    EXPECT_EQ(hexText(0), "0x0");
+    EXPECT_EQ(withoutNamespace("refray::procedural::d3d12::RayPayload"), "RayPayload");
+    EXPECT_EQ(withoutNamespace("RayPayload"), "RayPayload");
+}
