@@ -30,9 +30,9 @@ namespace {
 using namespace refray::procedural::math;
 namespace hlsl = refray::procedural::hlsl;
 using glm::dvec3;
-using testing::canonicalT1;
-using testing::radianceExtent;
-using testing::randomUnit;
+using fixtures::canonicalT1;
+using fixtures::radianceExtent;
+using fixtures::randomUnit;
 
 constexpr std::size_t kSetSize = 256;  // points / rays per set (a power of two)
 

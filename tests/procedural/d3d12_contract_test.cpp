@@ -28,11 +28,14 @@
 #include "procedural/math/metaballs.h"
 #include "procedural/math/sdf.h"
 #include "procedural/precision.h"
+#include "tests/procedural/contract_support.h"
 
 namespace refray::procedural::d3d12 {
 namespace {
 
 using namespace refray::dxr;
+using procedural::fixtures::angleBetween;
+using procedural::fixtures::occluderAcross;
 
 // ---- The primitives (§1.3, §1.4) and their rays ----------------------------------------------------
 
@@ -258,17 +261,6 @@ private:
     DescriptorHeap* heap_ = nullptr;
     Outcome outcome_;
 };
-
-// An opaque triangle across `ray` at world distance t, front-facing to it (DXR: dot(d, (v1-v0)x(v2-v0)) < 0).
-std::array<vec3, 3> occluderAcross(const RayDesc& ray, float t) {
-    const vec3 d = glm::normalize(ray.Direction);
-    const vec3 u = glm::normalize(glm::cross(d, std::abs(d.y) < 0.9f ? vec3(0, 1, 0) : vec3(1, 0, 0)));
-    const vec3 v = glm::cross(d, u);
-    const vec3 c = ray.Origin + t * ray.Direction;
-    std::array<vec3, 3> tri = {c - 0.5f * u - 0.5f * v, c + 0.5f * u - 0.5f * v, c + 0.5f * v};
-    if (glm::dot(d, glm::cross(tri[1] - tri[0], tri[2] - tri[0])) > 0.0f) std::swap(tri[1], tri[2]);
-    return tri;
-}
 
 // The sign the HLSL's IsCulled tests: dot(d_L, n_L) for the reported world normal n of a hit of `ray` under the
 // translation-only instance. n = normalize(n_L·l2b) there (I1), so n_L ∝ n·b2l and d_L = d·b2l (3x3 parts).
@@ -562,10 +554,6 @@ INSTANTIATE_TEST_SUITE_P(D3D12, D3D12FarSide,
                          paramName);
 
 // ---- Float vs double ----------------------------------------------------------------------------------------
-
-double angleBetween(vec3 a, vec3 b) {
-    return std::acos(std::clamp(glm::dot(glm::normalize(dvec3(a)), glm::normalize(dvec3(b))), -1.0, 1.0));
-}
 
 // PORT (makeD3D12ShaderLibrary's precision): each primitive's ray traced with the float and the double library.
 // Bounds, per intersection test (u = 2^-24 ~ 6e-8; t is 3-10 here, so one ulp of t is up to 1e-6):

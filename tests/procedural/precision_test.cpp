@@ -40,10 +40,10 @@ namespace {
 
 using glm::dvec3;
 using glm::vec3;
-using testing::canonicalT1;
-using testing::radianceExtent;
-using testing::randomUnit;
-using testing::RayPair;
+using fixtures::canonicalT1;
+using fixtures::radianceExtent;
+using fixtures::randomUnit;
+using fixtures::RayPair;
 
 constexpr int kPoints = 2000;
 constexpr int kRays = 1000;
@@ -202,7 +202,7 @@ struct MarchBound {
 };
 
 // kRays rays from the sphere of radius rOrigin around `centre`, aimed within rAim of `target`, each in
-// float and promoted exactly to double (testing::rayPair).
+// float and promoted exactly to double (fixtures::rayPair).
 std::vector<RayPair> rays(std::uint32_t seed, const dvec3& centre, double rOrigin, const dvec3& target, double rAim) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -210,7 +210,7 @@ std::vector<RayPair> rays(std::uint32_t seed, const dvec3& centre, double rOrigi
     while (int(out.size()) < kRays) {
         const dvec3 o = centre + rOrigin * randomUnit(rng);
         const dvec3 aim = target + rAim * std::cbrt(u(rng)) * randomUnit(rng);
-        out.push_back(testing::rayPair(o, aim));
+        out.push_back(fixtures::rayPair(o, aim));
     }
     return out;
 }
@@ -306,7 +306,7 @@ std::vector<RayPair> juliaSideRays(std::uint32_t seed) {
         const double phi = 2 * std::numbers::pi * u(rng);
         const dvec3 o(1.6 * std::cos(phi), -0.9 + 0.7 * u(rng), 1.6 * std::sin(phi));
         const dvec3 aim = dvec3(0, -0.55, 0) + 0.5 * std::cbrt(u(rng)) * randomUnit(rng);
-        out.push_back(testing::rayPair(o, aim));
+        out.push_back(fixtures::rayPair(o, aim));
     }
     return out;
 }

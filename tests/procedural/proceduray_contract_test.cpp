@@ -22,11 +22,14 @@
 #include "procedural/math/fractals.h"
 #include "procedural/precision.h"
 #include "procedural/proceduray/proceduray_shaders.h"
+#include "tests/procedural/contract_support.h"
 
 namespace refray::procedural::proceduray {
 namespace {
 
 using namespace refray::dxr;
+using procedural::fixtures::angleBetween;
+using procedural::fixtures::occluderAcross;
 
 // ---- The rig --------------------------------------------------------------------------------------
 
@@ -231,17 +234,6 @@ private:
     DescriptorHeap* heap_ = nullptr;
     Outcome outcome_;
 };
-
-// An opaque triangle across `ray` at world distance t, front-facing to it (DXR: dot(d, (v1-v0)x(v2-v0)) < 0).
-std::array<vec3, 3> occluderAcross(const RayDesc& ray, float t) {
-    const vec3 d = glm::normalize(ray.Direction);
-    const vec3 u = glm::normalize(glm::cross(d, std::abs(d.y) < 0.9f ? vec3(0, 1, 0) : vec3(1, 0, 0)));
-    const vec3 v = glm::cross(d, u);
-    const vec3 c = ray.Origin + t * ray.Direction;
-    std::array<vec3, 3> tri = {c - 0.5f * u - 0.5f * v, c + 0.5f * u - 0.5f * v, c + 0.5f * v};
-    if (glm::dot(d, glm::cross(tri[1] - tri[0], tri[2] - tri[0])) > 0.0f) std::swap(tri[1], tri[2]);
-    return tri;
-}
 
 // ---- The contract, per intersection shader and precision ------------------------------------------
 
@@ -503,10 +495,6 @@ Outcome traceWith(Precision precision, const ProceduralCase& c, const RayDesc& r
     rig.ray = ray;
     rig.scene.elapsedTime = elapsedTime;
     return rig.trace();
-}
-
-double angleBetween(vec3 a, vec3 b) {
-    return std::acos(std::clamp(glm::dot(glm::normalize(dvec3(a)), glm::normalize(dvec3(b))), -1.0, 1.0));
 }
 
 void report(const char* what, const Outcome& f, const Outcome& d) {

@@ -8,7 +8,7 @@
 
 #include "procedural/math/ray.h"
 
-namespace refray::procedural::math::testing {
+namespace refray::procedural::math::fixtures {
 
 // A uniformly distributed unit vector.
 inline glm::dvec3 randomUnit(std::mt19937& rng) {
@@ -54,4 +54,4 @@ inline float canonicalT1() {
     return t;
 }
 
-}  // namespace refray::procedural::math::testing
+}  // namespace refray::procedural::math::fixtures

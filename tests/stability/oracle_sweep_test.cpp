@@ -38,10 +38,10 @@ namespace {
 
 using glm::dvec3;
 using glm::vec3;
-using testing::canonicalT1;
-using testing::radianceExtent;
-using testing::randomUnit;
-using testing::RayPair;
+using fixtures::canonicalT1;
+using fixtures::radianceExtent;
+using fixtures::randomUnit;
+using fixtures::RayPair;
 
 constexpr int kRays = 10000;
 
@@ -56,7 +56,7 @@ std::vector<RayPair> sweepRays(std::uint32_t seed, const dvec3& lo, const dvec3&
     while (int(out.size()) < kRays) {
         const dvec3 o = centre + rOrigin * randomUnit(rng);
         const dvec3 aim(lo.x + (hi.x - lo.x) * u(rng), lo.y + (hi.y - lo.y) * u(rng), lo.z + (hi.z - lo.z) * u(rng));
-        out.push_back(testing::rayPair(o, aim));
+        out.push_back(fixtures::rayPair(o, aim));
     }
     return out;
 }
