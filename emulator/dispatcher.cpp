@@ -598,9 +598,9 @@ std::string vec3Values(const vec3& v) {
 }
 
 void validateRay(ThreadState& ts, const Site& site, const RayDesc& ray, bool& ok) {
-    const bool finite = allFinite(ray.Origin) && allFinite(ray.Direction) && std::isfinite(ray.TMin);
-    if (finite && !std::isnan(ray.TMax) && ray.TMin >= 0.0f && ray.TMin <= ray.TMax && ray.Direction != vec3(0.0f) &&
-        inTraversalRange(ray))
+    // inTraversalRange also fails for NaN and infinite components, so it covers their finiteness too.
+    if (inTraversalRange(ray) && std::isfinite(ray.TMin) && !std::isnan(ray.TMax) && ray.TMin >= 0.0f &&
+        ray.TMin <= ray.TMax && ray.Direction != vec3(0.0f))
         return;  // the common case: nothing to report
     auto field = [&](const char* name, float v) {
         if (std::isnan(v)) {
@@ -746,9 +746,9 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
     ts.stats.raysPerDepth[rs.depth]++;
     ts.rayCounter++;
 
-    // RAY-7: an infinite origin or direction component makes the plain math NaN, so the
-    // ray finds nothing (and Embree, which refuses such rays, never sees it).
-    const bool traceable = allFinite(ray.Origin) && allFinite(ray.Direction) && inTraversalRange(ray);
+    // RAY-7: an infinite origin or direction component makes the plain math NaN, so the ray finds nothing;
+    // components beyond Embree's range get the same treatment. Embree never sees either kind of ray.
+    const bool traceable = inTraversalRange(ray);  // false for NaN and infinite components too
     if (asAddress != 0 && traceable) {
         if (asAddress != ts.lastTlasAddress) {
             ts.lastTlas = ds.device->findTopLevelAS(asAddress);
