@@ -472,7 +472,9 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay) {
 
 }  // namespace
 
-std::shared_ptr<ShaderLibrary> makeD3D12ShaderLibrary(Precision precision, const TraceRayArgumentSet& traceRay) {
+std::shared_ptr<ShaderLibrary> makeD3D12ShaderLibrary(Precision precision, const TraceRayArgumentSet& traceRay,
+                                                      const Accuracy& accuracy) {
+    (void)accuracy;  // knobs not wired yet
     auto lib = std::make_shared<ShaderLibrary>();
     if (precision == Precision::Double) addExports<double>(*lib, traceRay);
     else addExports<float>(*lib, traceRay);

@@ -23,9 +23,10 @@
 #include "core/math.h"
 #include "emulator/root_signature.h"
 #include "emulator/state_object.h"
-#include "procedural/sample_layout.h"
+#include "procedural/accuracy.h"
 #include "procedural/math/fractals.h"
 #include "procedural/precision.h"
+#include "procedural/sample_layout.h"
 #include "procedural/trace_ray_parameters.h"
 
 namespace refray::procedural::d3d12 {
@@ -177,8 +178,10 @@ std::vector<std::string> aabbHitGroupNames();
 // PORT: `precision` selects the scalar type of the shader-internal math (Precision::Double is not the GPU's).
 // PORT: `traceRay` holds the TraceRay arguments the HLSL compiles in as constants, per ray type; the default is the
 // HLSL's. Other values reproduce the shaders compiled with other constants (IDX-1, IDX-7).
+// PORT: `accuracy` replaces the HLSL's march constants (procedural/accuracy.h); the default is the HLSL's.
 std::shared_ptr<dxr::ShaderLibrary> makeD3D12ShaderLibrary(
-    Precision precision = Precision::Float, const TraceRayArgumentSet& traceRay = defaultTraceRayArguments());
+    Precision precision = Precision::Float, const TraceRayArgumentSet& traceRay = defaultTraceRayArguments(),
+    const Accuracy& accuracy = {});
 
 // ---- The ground plane's index and vertex buffers (§1.2) ----------------------------------------------
 // What the app uploads as g_indices (6 16-bit indices, a raw view) and g_vertices (4 vertices, stride 24), which

@@ -22,8 +22,9 @@
 #include "core/math.h"
 #include "emulator/root_signature.h"
 #include "emulator/state_object.h"
-#include "procedural/sample_layout.h"
+#include "procedural/accuracy.h"
 #include "procedural/precision.h"
+#include "procedural/sample_layout.h"
 #include "procedural/trace_ray_parameters.h"
 
 namespace refray::procedural::proceduray {
@@ -153,8 +154,10 @@ std::vector<dxr::HitGroupDesc> procedurayHitGroups();
 // PORT: `precision` selects the scalar type of the shader-internal math (Precision::Double is not the GPU's).
 // PORT: `traceRay` holds the TraceRay arguments the HLSL compiles in as constants, per ray type; the default is the
 // HLSL's. Other values reproduce the shaders compiled with other constants (IDX-1, IDX-7).
+// PORT: `accuracy` replaces the HLSL's march constants (procedural/accuracy.h); the default is the HLSL's.
 std::shared_ptr<dxr::ShaderLibrary> makeProcedurayShaderLibrary(
-    Precision precision = Precision::Float, const TraceRayArgumentSet& traceRay = defaultTraceRayArguments());
+    Precision precision = Precision::Float, const TraceRayArgumentSet& traceRay = defaultTraceRayArguments(),
+    const Accuracy& accuracy = {});
 
 // ---- The slab's index and vertex buffers (§1.1) ----------------------------------------------------
 // What the scene uploads as g_indices (36 16-bit indices = 18 dwords, a raw view) and g_vertices (8 vertices,
