@@ -68,6 +68,19 @@ std::string withoutNamespace(std::string_view qualified) {
     return std::string(colon == std::string_view::npos ? qualified : qualified.substr(colon + 2));
 }
 
+std::string shellQuoted(std::string_view text) {
+    const bool plain = !text.empty() && std::all_of(text.begin(), text.end(), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) || std::string_view("_./:=,+-").find(c) != std::string_view::npos;
+    });
+    if (plain) return std::string(text);
+    std::string out = "'";
+    for (const char c : text) {
+        if (c == '\'') out += "'\\''";
+        else out += c;
+    }
+    return out + "'";
+}
+
 std::string htmlEscape(std::string_view text) {
     std::string out;
     for (const char c : text) {

@@ -28,6 +28,9 @@ std::string hexText(uint64_t value, int digits = 0);
 // "Name" of "a::b::Name" (a demangled C++ type as scene files write it).
 std::string withoutNamespace(std::string_view qualified);
 
+// `text` as one POSIX shell word: unchanged when it has only [A-Za-z0-9_./:=,+-], else in single quotes (a quote
+// inside becomes '\'').
+std::string shellQuoted(std::string_view text);
 // `text` with &, <, >, " and ' escaped for HTML.
 std::string htmlEscape(std::string_view text);
 // A float as the shortest decimal text that reads back as the same float ("0.1", "1e+30", "nan").

@@ -44,4 +44,14 @@ inline uint32_t scaledSteps(uint32_t hlslSteps, double stepsFactor) {
     return steps >= 2147483647.0 ? 2147483647u : uint32_t(steps);
 }
 
+// A constant of the HLSL, already in the shader's scalar type T, times a factor rounded to T: the constant itself,
+// bit for bit, when the factor is 1 (the shader libraries scale thresholds and normal offsets with it).
+template <typename T>
+T scaledConstant(T hlslValue, double factor) {
+    return factor == 1.0 ? hlslValue : hlslValue * static_cast<T>(factor);
+}
+
+// A count for one of the HLSL's int loop counters: at most 2^31 - 1.
+inline int hlslLoopCount(uint32_t count) { return count >= 2147483647u ? 2147483647 : int(count); }
+
 }  // namespace refray::procedural

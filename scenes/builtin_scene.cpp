@@ -9,7 +9,7 @@ namespace refray::scenes {
 using namespace refray::dxr;
 namespace builtin = refray::procedural::builtin;
 
-BuiltinScene::BuiltinScene() {
+BuiltinScene::BuiltinScene(const BuiltinSceneOptions& options) : options_(options) {
     GpuMemory& memory = device_.memory();
 
     // BLAS 0: the plane, two triangles at y = 0 whose cross(v1-v0, v2-v0) points up, so rays
@@ -39,8 +39,9 @@ BuiltinScene::BuiltinScene() {
 
     // TLAS: instance contributions 0 and 2 (two records per geometry, one per ray type).
     const std::vector<InstanceDesc> instances = {
-        makeInstanceDesc(Matrix3x4::identity(), 0, 0xFF, 0, INSTANCE_FLAG_NONE, planeBlas),
-        makeInstanceDesc(Matrix3x4::translation(kSphereCentre), 1, 0xFF, 2, INSTANCE_FLAG_NONE, sphereBlas),
+        makeInstanceDesc(Matrix3x4::translation(options.worldOffset), 0, 0xFF, 0, INSTANCE_FLAG_NONE, planeBlas),
+        makeInstanceDesc(Matrix3x4::translation(kSphereCentre + options.worldOffset), 1, 0xFF, 2, INSTANCE_FLAG_NONE,
+                         sphereBlas),
     };
     tlas_ = device_.buildTopLevelAS({BUILD_FLAG_PREFER_FAST_TRACE, uint32_t(instances.size()), ElementsLayout::Array,
                                      memory.upload(instances, "instance descs")});
@@ -60,7 +61,7 @@ BuiltinScene::BuiltinScene() {
     // The pipeline.
     StateObjectDesc so;
     so.name = "builtin";
-    so.libraries = {{builtin::makeShaderLibrary(), {}}};
+    so.libraries = {{builtin::makeShaderLibrary(options.secondaryRays), {}}};
     so.hitGroups = {
         {"HitGroup_Plane", HitGroupType::Triangles, "", "ClosestHit_Plane", ""},
         {"HitGroup_Plane_Shadow", HitGroupType::Triangles, "", "", ""},
@@ -94,16 +95,16 @@ BuiltinScene::BuiltinScene() {
                                 .upload(memory);
 }
 
-builtin::SceneConstants BuiltinScene::sceneConstants(uint32_t width, uint32_t height) {
+builtin::SceneConstants BuiltinScene::sceneConstants(uint32_t width, uint32_t height, vec3 worldOffset) {
     // Camera: eye up and to the side, looking at the sphere; 45 degree vertical field of view.
-    const vec3 eye{4.5f, 3.0f, 6.0f}, target{0.0f, 0.8f, 0.0f};
+    const vec3 eye = vec3(4.5f, 3.0f, 6.0f) + worldOffset, target = vec3(0.0f, 0.8f, 0.0f) + worldOffset;
     const vec3 forward = glm::normalize(target - eye);
     const vec3 right = glm::normalize(glm::cross(forward, vec3(0, 1, 0)));
     const vec3 up = glm::cross(right, forward);
     const float tanHalf = std::tan(0.5f * 0.7853982f);
     const float aspect = float(width) / float(height);
     return {vec4(eye, 1),     vec4(right * tanHalf * aspect, 0), vec4(up * tanHalf, 0),
-            vec4(forward, 0), vec4(-3.0f, 7.0f, 4.0f, 1.0f),     vec4(0, 0, 0, kSphereRadius)};
+            vec4(forward, 0), vec4(vec3(-3.0f, 7.0f, 4.0f) + worldOffset, 1.0f), vec4(0, 0, 0, kSphereRadius)};
 }
 
 RenderResult BuiltinScene::render(const RenderSettings& settings) {
@@ -113,7 +114,7 @@ RenderResult BuiltinScene::render(const RenderSettings& settings) {
     DescriptorHeap& heap = *outputHeap_;
     heap.setTexture2D(0, DescriptorRangeType::UAV, &result.image);
 
-    const builtin::SceneConstants constants = sceneConstants(settings.width, settings.height);
+    const builtin::SceneConstants constants = sceneConstants(settings.width, settings.height, options_.worldOffset);
     const GpuVirtualAddress cb = device_.memory().upload(&constants, sizeof constants, "scene constants");
 
     GlobalRootArguments globals(globalSignature_);

@@ -11,6 +11,12 @@
 
 namespace refray::scenes {
 
+// Variations of the built-in scene for the self-intersection study (issue 6).
+struct BuiltinSceneOptions {
+    vec3 worldOffset{0.0f};  // everything (plane, sphere, camera, light) moved by this much
+    procedural::builtin::SecondaryRayOrigin secondaryRays = procedural::builtin::SecondaryRayOrigin::WaechterBinder;
+};
+
 class BuiltinScene {
 public:
     // The scene's geometry and materials (also used by the raw-Embree benchmark baseline).
@@ -20,10 +26,10 @@ public:
     static constexpr vec4 kPlaneAlbedo{0.9f, 0.85f, 0.75f, 0.0f};
     static constexpr vec4 kSphereAlbedo{0.8f, 0.25f, 0.2f, 0.35f};  // .w: reflectance
 
-    BuiltinScene();
+    explicit BuiltinScene(const BuiltinSceneOptions& options = {});
     RenderResult render(const RenderSettings& settings);
-    // Camera and light constants for a width x height image.
-    static procedural::builtin::SceneConstants sceneConstants(uint32_t width, uint32_t height);
+    // Camera and light constants for a width x height image, everything moved by `worldOffset`.
+    static procedural::builtin::SceneConstants sceneConstants(uint32_t width, uint32_t height, vec3 worldOffset = vec3(0.0f));
 
     dxr::Device& device() { return device_; }
     const dxr::StateObjectPtr& pipeline() const { return pipeline_; }
@@ -31,6 +37,7 @@ public:
     dxr::GpuVirtualAddress tlas() const { return tlas_; }
 
 private:
+    BuiltinSceneOptions options_;
     dxr::Device device_;
     dxr::StateObjectPtr pipeline_;
     dxr::RootSignaturePtr globalSignature_;

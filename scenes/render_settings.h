@@ -11,6 +11,7 @@
 #include "core/progress.h"
 #include "emulator/device.h"
 #include "emulator/dispatcher.h"
+#include "procedural/accuracy.h"
 #include "procedural/precision.h"
 
 namespace refray::scenes {
@@ -27,6 +28,8 @@ struct RenderSettings {
     std::string camera;         // empty: the scene's default camera
     std::optional<float> time;  // empty: the scene's default time
     procedural::Precision precision = procedural::Precision::Float;
+    // The shader library's accuracy knobs (scenes/knobs.h); the default is the HLSL's constants.
+    procedural::Accuracy accuracy;
     // Samples per pixel: a square number n = k·k renders a k-times larger dispatch whose k x k pixel centres
     // fall on a regular grid inside each output pixel, averaged in float (the shaders' own ray generation runs
     // unchanged). 1 is the GPU's image.

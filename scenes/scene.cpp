@@ -1,11 +1,13 @@
 #include "scenes/scene.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
 
 #include "core/error.h"
 #include "core/strings.h"
+#include "scenes/knobs.h"
 #include "scenes/scene_loader.h"
 
 namespace refray::scenes {
@@ -132,26 +134,29 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
     for (const GlobalArgumentDesc& a : desc_.globalArguments) heapSize_ += uint32_t(a.table.size());
     if (heapSize_ > 0) heap_ = &device_.createDescriptorHeap(heapSize_, desc_.name + " descriptor heap");
 
-    pipelineFor(Precision::Float);  // validates the state object and the tables now
+    pipelineFor({});  // validates the state object and the tables now
 }
 
-Scene::Pipeline& Scene::pipelineFor(Precision precision) {
-    if (auto it = pipelines_.find(precision); it != pipelines_.end()) return it->second;
+Scene::Pipeline& Scene::pipelineFor(const LibraryOptions& options) {
+    if (auto it = pipelines_.find(options); it != pipelines_.end()) return it->second;
     const ShaderLibraryBinding& binding = findShaderLibrary(desc_.shaderLibrary);
 
     StateObjectDesc so;
-    so.name = desc_.name + " (" + std::string(procedural::toString(precision)) + ")";
+    so.name = desc_.name + " (" + std::string(procedural::toString(options.precision)) + ")";
     std::vector<procedural::TraceRayArguments> traceRay;  // what the shaders pass, per ray type
     for (const RayTypeDesc& t : desc_.rayTypes)
         traceRay.push_back({t.rayContribution, t.multiplier, t.missShaderIndex, t.instanceInclusionMask});
-    so.libraries = {{binding.make(precision, traceRay), {}}};
+    so.libraries = {{binding.make(options.precision, traceRay, options.accuracy), {}}};
     so.hitGroups = desc_.hitGroups;
     for (size_t i = 0; i < localSignatures_.size(); ++i)
         if (!desc_.localAssociations[i].empty())
             so.localRootSignatures.push_back({localSignatures_[i], desc_.localAssociations[i]});
     so.globalRootSignatures = {{globalSignature_, {}}};
     so.shaderConfigs = {{desc_.maxPayloadBytes, desc_.maxAttributeBytes}};
-    so.pipelineConfigs = {{desc_.maxRecursionDepth, PIPELINE_FLAG_NONE}};
+    // PORT: a recursion-depth knob is the shaders and the host recompiled with another MAX_RAY_RECURSION_DEPTH, so
+    // the pipeline allows at least that depth.
+    so.pipelineConfigs = {{std::max(desc_.maxRecursionDepth, options.accuracy.maxRecursionDepth.value_or(0)),
+                           PIPELINE_FLAG_NONE}};
     Pipeline p;
     p.stateObject = StateObject::create(so);
 
@@ -187,7 +192,7 @@ Scene::Pipeline& Scene::pipelineFor(Precision precision) {
         hitGroups.addRecord(id, args);
     }
     p.tables.HitGroupTable = hitGroups.upload(memory, desc_.hitGroupStride ? desc_.hitGroupStride : ~0ull);
-    return pipelines_.emplace(precision, std::move(p)).first->second;
+    return pipelines_.emplace(options, std::move(p)).first->second;
 }
 
 GpuVirtualAddress Scene::generateBuffer(const BufferDesc& b, const CameraDesc& camera, float time, uint32_t width,
@@ -242,7 +247,7 @@ RenderResult Scene::render(const RenderSettings& settings) {
     const float time = settings.time.value_or(desc_.defaultTime);
     REFRAY_CHECK(std::isfinite(time) && time >= 0.0f, "--time must be a finite, non-negative number of seconds, got " << time);
     const CameraDesc& camera = desc_.camera(settings.camera);
-    Pipeline& pipeline = pipelineFor(settings.precision);
+    Pipeline& pipeline = pipelineFor({settings.precision, settings.accuracy});
 
     Image target(width, height);
     std::vector<GpuVirtualAddress> frameAddresses(desc_.buffers.size(), 0);
@@ -311,6 +316,7 @@ RenderResult Scene::render(const RenderSettings& settings) {
     }
     meta["precision"] = std::string(procedural::toString(settings.precision));
     meta["spp"] = std::to_string(settings.spp);
+    meta["knobs"] = describeKnobs(settings);
     meta["size"] = std::to_string(settings.width) + "x" + std::to_string(settings.height);
     meta["traversal_order"] = settings.order == TraversalOrder::Ordered
                                   ? "ordered"

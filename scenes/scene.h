@@ -24,16 +24,26 @@ public:
     dxr::GpuVirtualAddress tlas() const { return tlas_; }
     // The GPU address of BLAS `index` (SceneDesc::blases order).
     dxr::GpuVirtualAddress blasAddress(size_t index) const { return blasAddresses_.at(index); }
-    // The state object and tables of `precision` (built on first use).
-    const dxr::StateObjectPtr& pipeline(procedural::Precision precision) { return pipelineFor(precision).stateObject; }
-    const dxr::DispatchRaysDesc& tables(procedural::Precision precision) { return pipelineFor(precision).tables; }
+    // The state object and tables of `precision` and `accuracy` (built on first use).
+    const dxr::StateObjectPtr& pipeline(procedural::Precision precision, const procedural::Accuracy& accuracy = {}) {
+        return pipelineFor({precision, accuracy}).stateObject;
+    }
+    const dxr::DispatchRaysDesc& tables(procedural::Precision precision, const procedural::Accuracy& accuracy = {}) {
+        return pipelineFor({precision, accuracy}).tables;
+    }
 
 private:
     struct Pipeline {
         dxr::StateObjectPtr stateObject;
         dxr::DispatchRaysDesc tables;
     };
-    Pipeline& pipelineFor(procedural::Precision precision);
+    // What a shader library is built with: one state object per distinct value.
+    struct LibraryOptions {
+        procedural::Precision precision = procedural::Precision::Float;
+        procedural::Accuracy accuracy;
+        friend auto operator<=>(const LibraryOptions&, const LibraryOptions&) = default;
+    };
+    Pipeline& pipelineFor(const LibraryOptions& options);
     dxr::GpuVirtualAddress generateBuffer(const BufferDesc& buffer, const CameraDesc& camera, float time, uint32_t width,
                                           uint32_t height);
 
@@ -44,7 +54,7 @@ private:
     dxr::GpuVirtualAddress tlas_ = 0;
     dxr::RootSignaturePtr globalSignature_;
     std::vector<dxr::RootSignaturePtr> localSignatures_;
-    std::map<procedural::Precision, Pipeline> pipelines_;
+    std::map<LibraryOptions, Pipeline> pipelines_;
     dxr::DescriptorHeap* heap_ = nullptr;
     uint32_t heapSize_ = 0;
 };

@@ -163,7 +163,7 @@ public:
             libraryValue.fail(e.what());
         }
         scene_.shaderLibrary = binding_->name;
-        library_ = binding_->make(procedural::Precision::Float, binding_->traceRayDefaults);
+        library_ = binding_->make(procedural::Precision::Float, binding_->traceRayDefaults, {});
 
         if (const Value* v = top.optional("layout")) {
             const uint32_t mode = resolveName(*v, {"auto", "explicit"}, "layout");

@@ -66,14 +66,17 @@ const std::vector<ShaderLibraryBinding>& shaderLibraries() {
     static const std::vector<ShaderLibraryBinding> libraries = {
         {"d3d12-procedural-geometry",
          "Microsoft D3D12RaytracingProceduralGeometry Raytracing.hlsl (procedural/d3d12/)",
-         [](procedural::Precision p, const std::vector<procedural::TraceRayArguments>& traceRay) {
-             return procedural::d3d12::makeD3D12ShaderLibrary(p, argumentSet(traceRay, "d3d12-procedural-geometry"));
+         [](procedural::Precision p, const std::vector<procedural::TraceRayArguments>& traceRay,
+            const procedural::Accuracy& accuracy) {
+             return procedural::d3d12::makeD3D12ShaderLibrary(p, argumentSet(traceRay, "d3d12-procedural-geometry"),
+                                                              accuracy);
          },
          d3d12Constants, false, procedural::d3d12::RayType::Count,
          perRayType(procedural::d3d12::defaultTraceRayArguments().rayTypes)},
         {"proceduray", "Proceduray MandelJuliaPac Raytracing.hlsl (procedural/proceduray/)",
-         [](procedural::Precision p, const std::vector<procedural::TraceRayArguments>& traceRay) {
-             return procedural::proceduray::makeProcedurayShaderLibrary(p, argumentSet(traceRay, "proceduray"));
+         [](procedural::Precision p, const std::vector<procedural::TraceRayArguments>& traceRay,
+            const procedural::Accuracy& accuracy) {
+             return procedural::proceduray::makeProcedurayShaderLibrary(p, argumentSet(traceRay, "proceduray"), accuracy);
          },
          procedurayConstants, true, procedural::proceduray::RayTypeCount,
          perRayType(procedural::proceduray::defaultTraceRayArguments().rayTypes)},

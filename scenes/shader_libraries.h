@@ -10,6 +10,7 @@
 
 #include "core/math.h"
 #include "emulator/state_object.h"
+#include "procedural/accuracy.h"
 #include "procedural/precision.h"
 #include "procedural/sample_layout.h"
 #include "procedural/trace_ray_parameters.h"
@@ -35,9 +36,9 @@ struct ShaderLibraryBinding {
     std::string name;         // what scene files write in "shaderLibrary"
     std::string description;  // which HLSL it ports
     // Makes the library with its shaders' TraceRay arguments, one entry per ray type (exactly rayTypeCount; other
-    // counts throw refray::Error). `traceRayDefaults` gives the library's own.
-    std::function<std::shared_ptr<dxr::ShaderLibrary>(procedural::Precision,
-                                                      const std::vector<procedural::TraceRayArguments>&)>
+    // counts throw refray::Error), and its accuracy knobs. `traceRayDefaults` gives the library's own.
+    std::function<std::shared_ptr<dxr::ShaderLibrary>(
+        procedural::Precision, const std::vector<procedural::TraceRayArguments>&, const procedural::Accuracy&)>
         make;
     // The bytes of the library's SceneConstantBuffer (its C++ struct, padding zeroed).
     std::function<std::vector<uint8_t>(const SceneConstantsInput&)> sceneConstants;

@@ -10,17 +10,19 @@
 
 #include "core/error.h"
 #include "core/image.h"
+#include "core/strings.h"
 #include "emulator/validation.h"
 #include "procedural/precision.h"
 #include "scenes/builtin_scene.h"
-#include "core/strings.h"
 #include "scenes/golden.h"
 #include "scenes/index_map.h"
+#include "scenes/knobs.h"
 #include "scenes/order_check.h"
 #include "scenes/scene.h"
 #include "tools/cli_common.h"
 #include "tools/compare_command.h"
 #include "tools/explain_command.h"
+#include "tools/sweep_command.h"
 #include "tools/table_command.h"
 #include "tools/version.h"
 
@@ -60,6 +62,7 @@ struct RenderOptions {
     uint32_t spp = 1;
     uint32_t orderCheck = 0;
     std::string aov;
+    std::vector<std::string> knobs;  // "name=value"
 };
 
 // --aov: the index map with its legend beside it; the legend also goes to stdout.
@@ -98,12 +101,14 @@ int runRender(const RenderOptions& o) {
     REFRAY_CHECK(precision, "--precision expects 'float' or 'double', got '" << o.precision << "'");
     settings.precision = *precision;
     settings.spp = o.spp;
+    for (const std::string& k : o.knobs) scenes::applyKnobAssignment(settings, k);
 
     scenes::RenderResult result;
     if (o.scene == "builtin") {
-        REFRAY_CHECK(o.camera.empty() && !o.time && o.spp == 1 && o.precision == "float" && o.orderCheck == 0 && o.aov.empty(),
+        REFRAY_CHECK(o.camera.empty() && !o.time && o.spp == 1 && o.precision == "float" && o.orderCheck == 0 && o.aov.empty() &&
+                         o.knobs.empty(),
                      "the built-in scene has one camera, no time, one sample per pixel and float shaders; "
-                     "--camera, --time, --spp, --precision, --order-check and --aov are for scene files");
+                     "--camera, --time, --spp, --precision, --knob, --order-check and --aov are for scene files");
         const Size size = parseSize(o.size.empty() ? "640x360" : o.size);
         settings.width = size.width, settings.height = size.height;
         scenes::BuiltinScene scene;
@@ -166,6 +171,10 @@ int main(int argc, char** argv) {
     render->add_option("--spp", ro.spp, "Samples per pixel: a square number (k x k pixel centres of a k-times larger "
                                         "dispatch, averaged)")
         ->capture_default_str();
+    render->add_option("--knob", ro.knobs,
+                       "An accuracy knob, NAME=VALUE (repeatable): steps, threshold, mandelbulb-iterations, "
+                       "julia-iterations, normal-epsilon, metaball-steps, recursion-depth, spp, precision "
+                       "(see 'refray sweep --help')");
     render->add_option("--threads", ro.threads, "Worker threads (0: all)")->capture_default_str();
     render->add_option("--order", ro.order, "Traversal order: ordered (default) or adversarial (GEN-3)");
     render->add_option("--seed", ro.seed, "Seed of the adversarial order");
@@ -182,6 +191,9 @@ int main(int argc, char** argv) {
 
     refray::tools::TableCommandOptions tableOptions;
     CLI::App* table = refray::tools::addTableCommand(app, tableOptions);
+
+    refray::tools::SweepCommandOptions sweepOptions;
+    CLI::App* sweep = refray::tools::addSweepCommand(app, sweepOptions);
 
     refray::tools::ExplainCommandOptions explainOptions;
     CLI::App* explain = refray::tools::addExplainCommand(app, explainOptions);
@@ -203,6 +215,7 @@ int main(int argc, char** argv) {
         if (*compare) return refray::tools::runCompare(compareOptions);
         if (*table) return refray::tools::runTable(tableOptions);
         if (*explain) return refray::tools::runExplain(explainOptions);
+        if (*sweep) return refray::tools::runSweep(sweepOptions);
         if (*update) {
             const Size size = parseSize(goldenSize);
             scenes::GoldenUpdateOptions options;

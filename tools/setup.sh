@@ -11,6 +11,7 @@ packages=(
   chromium  # the compare tool's HTML report is checked in headless Chromium
   fonts-dejavu-core  # legends of index maps (refray render --aov) are drawn with DejaVu Sans
   clang libclang-rt-14-dev  # libFuzzer programs (tools/fuzz.sh)
+  parallel  # the README's example of running 'refray sweep --emit-jobs' lines (a test runs it)
 )
 
 missing=()

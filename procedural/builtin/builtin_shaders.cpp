@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "core/ray_offset.h"
 #include "emulator/shader_api.h"
 
 namespace refray::procedural::builtin {
@@ -11,6 +12,20 @@ using namespace refray::dxr;
 namespace {
 
 constexpr float kTMax = 10000.0f;
+constexpr float kFixedTMin = 0.001f;
+
+// Where a secondary ray leaving `position` (geometric normal `normal`) in `direction` starts, and its TMin.
+RayDesc secondaryRay(SecondaryRayOrigin mode, vec3 position, vec3 normal, vec3 direction, float tMax) {
+    switch (mode) {
+        case SecondaryRayOrigin::WaechterBinder: {
+            const vec3 side = glm::dot(normal, direction) >= 0.0f ? normal : -normal;
+            return RayDesc{offsetRayOrigin(position, side), 0.0f, direction, tMax};
+        }
+        case SecondaryRayOrigin::FixedTMin: return RayDesc{position, kFixedTMin, direction, tMax};
+        case SecondaryRayOrigin::HitPoint: break;
+    }
+    return RayDesc{position, 0.0f, direction, tMax};
+}
 
 SceneConstants sceneConstants(ShaderContext& ctx) {
     return ctx.load<SceneConstants>(ctx.globalRootDescriptor(kSceneConstants));
@@ -18,29 +33,30 @@ SceneConstants sceneConstants(ShaderContext& ctx) {
 
 vec3 hitWorldPosition(ShaderContext& ctx) { return ctx.WorldRayOrigin() + ctx.RayTCurrent() * ctx.WorldRayDirection(); }
 
-vec4 traceRadiance(ShaderContext& ctx, vec3 origin, vec3 direction, uint32_t depth) {
+vec4 traceRadiance(ShaderContext& ctx, const RayDesc& ray, uint32_t depth) {
     if (depth >= kMaxRecursionDepth) return vec4(0.0f);
     RadiancePayload payload{vec4(0.0f), depth + 1};
     ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_CULL_BACK_FACING_TRIANGLES, 0xFF, 0,
-                 kRayTypeCount, 0, RayDesc{origin, 0.001f, direction, kTMax}, payload);
+                 kRayTypeCount, 0, ray, payload);
     return payload.color;
 }
 
-bool inShadow(ShaderContext& ctx, vec3 origin, vec3 toLight, float distance, uint32_t depth) {
+bool inShadow(ShaderContext& ctx, const RayDesc& ray, uint32_t depth) {
     if (depth >= kMaxRecursionDepth) return false;
     ShadowPayload payload{1};
     ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure),
                  RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_SKIP_CLOSEST_HIT_SHADER, 0xFF,
-                 1, kRayTypeCount, 1, RayDesc{origin, 0.001f, toLight, distance}, payload);
+                 1, kRayTypeCount, 1, ray, payload);
     return payload.hit != 0;
 }
 
-vec3 shade(ShaderContext& ctx, vec3 albedo, vec3 normal, vec3 position, uint32_t depth) {
+// `normal` is the geometric normal (the plane's and the sphere's are their shading normals too).
+vec3 shade(ShaderContext& ctx, SecondaryRayOrigin mode, vec3 albedo, vec3 normal, vec3 position, uint32_t depth) {
     const SceneConstants sc = sceneConstants(ctx);
     const vec3 toLight = vec3(sc.lightPosition) - position;
     const float distance = glm::length(toLight);
     const vec3 l = toLight / distance;
-    const bool shadowed = glm::dot(normal, l) > 0.0f && inShadow(ctx, position, l, distance, depth);
+    const bool shadowed = glm::dot(normal, l) > 0.0f && inShadow(ctx, secondaryRay(mode, position, normal, l, distance), depth);
     return lambert(albedo, normal, l, shadowed);
 }
 
@@ -83,14 +99,23 @@ vec3 primaryDirection(const SceneConstants& sc, uvec3 index, uvec3 dims) {
     return glm::normalize(vec3(sc.cameraForward) + sx * vec3(sc.cameraRight) + sy * vec3(sc.cameraUp));
 }
 
-std::shared_ptr<ShaderLibrary> makeShaderLibrary() {
+std::string_view toString(SecondaryRayOrigin origin) {
+    switch (origin) {
+        case SecondaryRayOrigin::WaechterBinder: return "waechter-binder";
+        case SecondaryRayOrigin::FixedTMin: return "fixed-tmin";
+        case SecondaryRayOrigin::HitPoint: return "hit-point";
+    }
+    return "?";
+}
+
+std::shared_ptr<ShaderLibrary> makeShaderLibrary(SecondaryRayOrigin mode) {
     auto lib = std::make_shared<ShaderLibrary>();
 
     lib->addRayGeneration("RayGen", [](ShaderContext& ctx) {
         const uvec3 index = ctx.DispatchRaysIndex();
         const SceneConstants sc = sceneConstants(ctx);
         const vec3 d = primaryDirection(sc, index, ctx.DispatchRaysDimensions());
-        const vec4 color = traceRadiance(ctx, vec3(sc.cameraPosition), d, 0);
+        const vec4 color = traceRadiance(ctx, RayDesc{vec3(sc.cameraPosition), 0.001f, d, kTMax}, 0);
         ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputTable)).at(index.x, index.y) = color;
     });
 
@@ -101,10 +126,11 @@ std::shared_ptr<ShaderLibrary> makeShaderLibrary() {
     lib->addMiss<ShadowPayload>("Miss_Shadow", [](ShaderContext&, ShadowPayload& payload) { payload.hit = 0; });
 
     lib->addClosestHit<RadiancePayload, BuiltInTriangleIntersectionAttributes>(
-        "ClosestHit_Plane", [](ShaderContext& ctx, RadiancePayload& payload, const BuiltInTriangleIntersectionAttributes&) {
+        "ClosestHit_Plane", [mode](ShaderContext& ctx, RadiancePayload& payload, const BuiltInTriangleIntersectionAttributes&) {
             const MaterialConstants m = ctx.localRootConstants<MaterialConstants>(kMaterialParameter);
             const vec3 p = hitWorldPosition(ctx);
-            payload.color = vec4(shade(ctx, checkerAlbedo(p, vec3(m.albedo)), vec3(0.0f, 1.0f, 0.0f), p, payload.recursionDepth), 1.0f);
+            payload.color =
+                vec4(shade(ctx, mode, checkerAlbedo(p, vec3(m.albedo)), vec3(0.0f, 1.0f, 0.0f), p, payload.recursionDepth), 1.0f);
         });
 
     // Analytic sphere in object space; reports t in the caller's (object = world) units.
@@ -119,7 +145,7 @@ std::shared_ptr<ShaderLibrary> makeShaderLibrary() {
     });
 
     lib->addClosestHit<RadiancePayload, SphereAttributes>(
-        "ClosestHit_Sphere", [](ShaderContext& ctx, RadiancePayload& payload, const SphereAttributes& attr) {
+        "ClosestHit_Sphere", [mode](ShaderContext& ctx, RadiancePayload& payload, const SphereAttributes& attr) {
             const MaterialConstants m = ctx.localRootConstants<MaterialConstants>(kMaterialParameter);
             // Object-space normal to world: the inverse transpose of ObjectToWorld.
             const Matrix3x4 w2o = ctx.WorldToObject3x4();
@@ -127,11 +153,11 @@ std::shared_ptr<ShaderLibrary> makeShaderLibrary() {
                                                w2o.m[0][1] * attr.normal.x + w2o.m[1][1] * attr.normal.y + w2o.m[2][1] * attr.normal.z,
                                                w2o.m[0][2] * attr.normal.x + w2o.m[1][2] * attr.normal.y + w2o.m[2][2] * attr.normal.z));
             const vec3 p = hitWorldPosition(ctx);
-            vec3 color = shade(ctx, vec3(m.albedo), n, p, payload.recursionDepth);
+            vec3 color = shade(ctx, mode, vec3(m.albedo), n, p, payload.recursionDepth);
             const float reflectance = m.albedo.w;
             if (reflectance > 0.0f) {
                 const vec3 r = glm::reflect(ctx.WorldRayDirection(), n);
-                color += reflectance * vec3(traceRadiance(ctx, p, r, payload.recursionDepth));
+                color += reflectance * vec3(traceRadiance(ctx, secondaryRay(mode, p, n, r, kTMax), payload.recursionDepth));
             }
             payload.color = vec4(color, 1.0f);
         });

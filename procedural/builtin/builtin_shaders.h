@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string_view>
 
 #include "core/math.h"
 #include "emulator/state_object.h"
@@ -49,7 +50,15 @@ struct SphereAttributes {
 inline constexpr uint32_t kRayTypeCount = 2;  // radiance = 0, shadow = 1
 inline constexpr uint32_t kMaxRecursionDepth = 3;
 
-std::shared_ptr<dxr::ShaderLibrary> makeShaderLibrary();
+// Where the shaders start shadow and reflection rays (issue 6; docs/numerical-stability.md, "Self-intersection").
+enum class SecondaryRayOrigin {
+    WaechterBinder,  // the hit point moved off the surface by offsetRayOrigin (core/ray_offset.h), TMin 0: the default
+    FixedTMin,       // the hit point, TMin 0.001: a fixed epsilon (acne far from the origin)
+    HitPoint,        // the hit point, TMin 0: no protection (acne everywhere)
+};
+std::string_view toString(SecondaryRayOrigin origin);
+
+std::shared_ptr<dxr::ShaderLibrary> makeShaderLibrary(SecondaryRayOrigin origin = SecondaryRayOrigin::WaechterBinder);
 
 // The shading math, shared by the shaders and by the raw-Embree baseline of the
 // emulation-overhead benchmark (so both do exactly the same work per ray).

@@ -178,6 +178,37 @@ REFRAY_INSTANTIATE_HELPERS(float)
 REFRAY_INSTANTIATE_HELPERS(double)
 #undef REFRAY_INSTANTIATE_HELPERS
 
+// ---- Accuracy knobs --------------------------------------------------------------------------------
+
+template <typename T>
+math::SphereTraceParams<T> sphereTraceParams(const Accuracy& accuracy, T stepScale) {
+    math::SphereTraceParams<T> params;  // the HLSL's constants
+    params.threshold = scaledConstant(params.threshold, accuracy.thresholdFactor);
+    params.maxSteps = scaledSteps(params.maxSteps, accuracy.stepsFactor);
+    params.stepScale = stepScale;
+    params.normalOffset = scaledConstant(params.normalOffset, accuracy.normalEpsilonFactor);
+    return params;
+}
+
+template <typename T>
+math::MetaballsParams<T> metaballsParams(const Accuracy& accuracy) {
+    math::MetaballsParams<T> params;  // the HLSL's constants
+    if (accuracy.metaballSteps) params.maxSteps = *accuracy.metaballSteps;
+    params.normalOffset = scaledConstant(params.normalOffset, accuracy.normalEpsilonFactor);
+    return params;
+}
+
+uint32_t maxRayRecursionDepth(const Accuracy& accuracy) {
+    return accuracy.maxRecursionDepth.value_or(MAX_RAY_RECURSION_DEPTH);
+}
+
+#define REFRAY_INSTANTIATE_KNOBS(T)                                                                     \
+    template math::SphereTraceParams<T> sphereTraceParams<T>(const Accuracy&, T);                       \
+    template math::MetaballsParams<T> metaballsParams<T>(const Accuracy&);
+REFRAY_INSTANTIATE_KNOBS(float)
+REFRAY_INSTANTIATE_KNOBS(double)
+#undef REFRAY_INSTANTIATE_KNOBS
+
 // ---- Shader-side helpers (Raytracing.hlsl) ---------------------------------------------------------
 
 namespace {
@@ -241,10 +272,12 @@ math::RayExtent<T> CurrentExtent(const ShaderContext& ctx) {
 // PORT: the HLSL passes the constants TraceRayParameters::InstanceMask, TraceRayParameters::HitGroup::Offset[rayType],
 // TraceRayParameters::HitGroup::GeometryStride and TraceRayParameters::MissShader::Offset[rayType]; here they come
 // from `traceRay` (the library's TraceRayArgumentSet, those same values by default), which every caller passes down.
+// PORT: MAX_RAY_RECURSION_DEPTH is the library's `maxDepth` (maxRayRecursionDepth of its Accuracy), passed down
+// the same way.
 template <typename T>
-tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const tvec3<T>& origin,
-                          const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
-    if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH) return tvec4<T>(T(0));
+tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
+                          const tvec3<T>& origin, const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
+    if (currentRayRecursionDepth >= maxDepth) return tvec4<T>(T(0));
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     RayPayload rayPayload{vec4(0.0f), currentRayRecursionDepth + 1};
     const TraceRayArguments& radiance = traceRay[RayType::Radiance];
@@ -256,9 +289,10 @@ tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRa
 }
 
 template <typename T>
-bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const tvec3<T>& origin,
-                                  const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
-    if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH) return false;
+bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
+                                  const tvec3<T>& origin, const tvec3<T>& direction,
+                                  uint32_t currentRayRecursionDepth) {
+    if (currentRayRecursionDepth >= maxDepth) return false;
     // TMax 10000, not the distance to the light (I2).
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     // Starts as "hit": closest-hit and any-hit shaders are skipped, only MyMissShader_ShadowRay clears it.
@@ -275,31 +309,32 @@ bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet&
 
 // The shadow ray both closest hits start with: from HitWorldPosition() towards the light.
 template <typename T>
-bool TraceShadowRayTowardsLight(ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
+bool TraceShadowRayTowardsLight(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
                                 const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth) {
     const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
-    return TraceShadowRayAndReportIfHit(ctx, traceRay, hitPosition,
+    return TraceShadowRayAndReportIfHit(ctx, traceRay, maxDepth, hitPosition,
                                         hlsl::normalize(tvec3<T>(vec3(g_sceneCB.lightPosition)) - hitPosition),
                                         recursionDepth);
 }
 
 // reflectanceCoef·(Fresnel, 1)·(reflection ray colour), the reflection ray leaving HitWorldPosition().
 template <typename T>
-tvec4<T> ReflectedColor(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const tvec3<T>& normal,
-                        const PrimitiveConstantBuffer& l_materialCB, uint32_t recursionDepth) {
+tvec4<T> ReflectedColor(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
+                        const tvec3<T>& normal, const PrimitiveConstantBuffer& l_materialCB, uint32_t recursionDepth) {
     const tvec3<T> D = tvec3<T>(ctx.WorldRayDirection());
-    const tvec4<T> reflectionColor =
-        TraceRadianceRay(ctx, traceRay, HitWorldPosition<T>(ctx), hlsl::reflect(D, normal), recursionDepth);
+    const tvec4<T> reflectionColor = TraceRadianceRay(ctx, traceRay, maxDepth, HitWorldPosition<T>(ctx),
+                                                      hlsl::reflect(D, normal), recursionDepth);
     const tvec3<T> fresnelR = FresnelReflectanceSchlick(D, normal, tvec3<T>(vec3(l_materialCB.albedo)));
     return T(l_materialCB.reflectanceCoef) * tvec4<T>(fresnelR, T(1)) * reflectionColor;
 }
 
 // ---- Entry points ----------------------------------------------------------------------------------
 // Each is a template on the scalar type; results are rounded to float where they cross the interface. Those that
-// trace rays take the library's TraceRay arguments (PORT: constants in the HLSL).
+// trace rays take the library's TraceRay arguments, and those that march or recurse its Accuracy (PORT: constants
+// in the HLSL).
 
 template <typename T>
-void MyRaygenShader(ShaderContext& ctx, const TraceRayArgumentSet& traceRay) {
+void MyRaygenShader(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const uvec3 index = ctx.DispatchRaysIndex();
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
@@ -307,15 +342,16 @@ void MyRaygenShader(ShaderContext& ctx, const TraceRayArgumentSet& traceRay) {
     GenerateCameraRay(uvec2(index), uvec2(ctx.DispatchRaysDimensions()), tvec3<T>(vec3(g_sceneCB.cameraPosition)),
                       g_sceneCB.projectionToWorld, origin, direction);
     const uint32_t currentRecursionDepth = 0;
-    const tvec4<T> color = TraceRadianceRay(ctx, traceRay, origin, direction, currentRecursionDepth);
+    const tvec4<T> color =
+        TraceRadianceRay(ctx, traceRay, maxRayRecursionDepth(accuracy), origin, direction, currentRecursionDepth);
     // PORT: the texture stores floats; the R8G8B8A8_UNORM conversion (clamp, round, NaN -> 0) happens when the
     // image is written out (H20).
     ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView)).at(index.x, index.y) = vec4(color);
 }
 
 template <typename T>
-void MyClosestHitShader_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, RayPayload& rayPayload,
-                                 const BuiltInTriangleIntersectionAttributes&) {
+void MyClosestHitShader_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                                 RayPayload& rayPayload, const BuiltInTriangleIntersectionAttributes&) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
@@ -333,7 +369,9 @@ void MyClosestHitShader_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& 
         ctx.loadFromTable<Vertex>(vertexBuffers, /*g_vertices*/ 1, uint64_t(indices[0]) * sizeof(Vertex)).normal);
 
     // Shadow component.
-    const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, traceRay, g_sceneCB, rayPayload.recursionDepth);
+    const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
+    const bool shadowRayHit =
+        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, g_sceneCB, rayPayload.recursionDepth);
 
     // Grid lines from the primary camera rays' footprint, even for secondary hits (I7, H4).
     const T checkers = AnalyticalCheckersTexture(
@@ -343,7 +381,8 @@ void MyClosestHitShader_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& 
     // Reflected component.
     tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, traceRay, triangleNormal, l_materialCB, rayPayload.recursionDepth);
+        reflectedColor =
+            ReflectedColor(ctx, traceRay, maxDepth, triangleNormal, l_materialCB, rayPayload.recursionDepth);
 
     // Final colour, then the visibility falloff.
     const tvec4<T> phongColor = CalculatePhongLighting(
@@ -355,18 +394,20 @@ void MyClosestHitShader_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& 
 }
 
 template <typename T>
-void MyClosestHitShader_AABB(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, RayPayload& rayPayload,
-                             const ProceduralPrimitiveAttributes& attr) {
+void MyClosestHitShader_AABB(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                             RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
     const tvec3<T> normal = tvec3<T>(attr.normal);
 
-    const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, traceRay, g_sceneCB, rayPayload.recursionDepth);
+    const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
+    const bool shadowRayHit =
+        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, g_sceneCB, rayPayload.recursionDepth);
 
     tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, traceRay, normal, l_materialCB, rayPayload.recursionDepth);
+        reflectedColor = ReflectedColor(ctx, traceRay, maxDepth, normal, l_materialCB, rayPayload.recursionDepth);
 
     const tvec4<T> phongColor = CalculatePhongLighting(
         g_sceneCB, tvec4<T>(l_materialCB.albedo), normal, shadowRayHit, T(l_materialCB.diffuseCoef),
@@ -403,7 +444,7 @@ void MyIntersectionShader_AnalyticPrimitive(ShaderContext& ctx) {
 }
 
 template <typename T>
-void MyIntersectionShader_VolumetricPrimitive(ShaderContext& ctx) {
+void MyIntersectionShader_VolumetricPrimitive(ShaderContext& ctx, const Accuracy& accuracy) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const PrimitiveInstancePerFrameBuffer aabbAttribute = primitiveAttributes(ctx);
     const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx, aabbAttribute);
@@ -412,9 +453,11 @@ void MyIntersectionShader_VolumetricPrimitive(ShaderContext& ctx) {
 
     // RayVolumetricGeometryIntersectionTest: metaballs animated over a 12 s cycle. The march step depends on
     // RayTCurrent() at call time (H10).
+    // PORT: the sample count and the normal's step come from the library's Accuracy.
     math::MetaballsHit<T> test;
     if (primitiveType == VolumetricPrimitive::Metaballs)
-        test = math::RayMetaballsIntersectionTest(localRay, CurrentExtent<T>(ctx), elapsedTime, T(12));
+        test = math::RayMetaballsIntersectionTest(localRay, CurrentExtent<T>(ctx), elapsedTime, T(12),
+                                                  metaballsParams<T>(accuracy));
     if (test.hit) {
         const ProceduralPrimitiveAttributes attr{vec3(NormalToWorld(ctx, aabbAttribute, test.normal))};
         ctx.ReportHit(float(test.thit), /*hitKind*/ 0, attr);
@@ -422,15 +465,15 @@ void MyIntersectionShader_VolumetricPrimitive(ShaderContext& ctx) {
 }
 
 template <typename T>
-void MyIntersectionShader_SignedDistancePrimitive(ShaderContext& ctx) {
+void MyIntersectionShader_SignedDistancePrimitive(ShaderContext& ctx, const Accuracy& accuracy) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const PrimitiveInstancePerFrameBuffer aabbAttribute = primitiveAttributes(ctx);
     const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx, aabbAttribute);
     const auto primitiveType = SignedDistancePrimitive(aabbCB(ctx).primitiveType);
 
     // RaySignedDistancePrimitiveTest: sphere tracing from RayTMin(), not from the box entry (I6).
-    math::SphereTraceParams<T> params;
-    params.stepScale = T(materialCB(ctx).stepScale);
+    // PORT: the threshold, step limit and normal offset come from the library's Accuracy.
+    const math::SphereTraceParams<T> params = sphereTraceParams(accuracy, T(materialCB(ctx).stepScale));
     const auto sdf = [primitiveType](const tvec3<T>& position) {
         return math::d3d12::GetDistanceFromSignedDistancePrimitive(position, primitiveType);
     };
@@ -442,20 +485,21 @@ void MyIntersectionShader_SignedDistancePrimitive(ShaderContext& ctx) {
     }
 }
 
-// Every export, with its math in T. The lambdas hold a copy of the TraceRay arguments, which the shaders that
-// trace rays take by reference.
+// Every export, with its math in T. The lambdas hold copies of the TraceRay arguments and the Accuracy, which the
+// shaders take by reference.
 template <typename T>
-void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay) {
-    lib.addRayGeneration("MyRaygenShader", [traceRay](ShaderContext& ctx) { MyRaygenShader<T>(ctx, traceRay); });
+void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy) {
+    lib.addRayGeneration("MyRaygenShader",
+                         [traceRay, accuracy](ShaderContext& ctx) { MyRaygenShader<T>(ctx, traceRay, accuracy); });
     lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
-        "MyClosestHitShader_Triangle",
-        [traceRay](ShaderContext& ctx, RayPayload& payload, const BuiltInTriangleIntersectionAttributes& attr) {
-            MyClosestHitShader_Triangle<T>(ctx, traceRay, payload, attr);
+        "MyClosestHitShader_Triangle", [traceRay, accuracy](ShaderContext& ctx, RayPayload& payload,
+                                                            const BuiltInTriangleIntersectionAttributes& attr) {
+            MyClosestHitShader_Triangle<T>(ctx, traceRay, accuracy, payload, attr);
         });
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "MyClosestHitShader_AABB",
-        [traceRay](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
-            MyClosestHitShader_AABB<T>(ctx, traceRay, payload, attr);
+        [traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
+            MyClosestHitShader_AABB<T>(ctx, traceRay, accuracy, payload, attr);
         });
     lib.addMiss<RayPayload>("MyMissShader", MyMissShader);
     lib.addMiss<ShadowRayPayload>("MyMissShader_ShadowRay", MyMissShader_ShadowRay);
@@ -464,20 +508,19 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay) {
         [](ShaderContext& ctx) { MyIntersectionShader_AnalyticPrimitive<T>(ctx); });
     lib.addIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_VolumetricPrimitive",
-        [](ShaderContext& ctx) { MyIntersectionShader_VolumetricPrimitive<T>(ctx); });
+        [accuracy](ShaderContext& ctx) { MyIntersectionShader_VolumetricPrimitive<T>(ctx, accuracy); });
     lib.addIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_SignedDistancePrimitive",
-        [](ShaderContext& ctx) { MyIntersectionShader_SignedDistancePrimitive<T>(ctx); });
+        [accuracy](ShaderContext& ctx) { MyIntersectionShader_SignedDistancePrimitive<T>(ctx, accuracy); });
 }
 
 }  // namespace
 
 std::shared_ptr<ShaderLibrary> makeD3D12ShaderLibrary(Precision precision, const TraceRayArgumentSet& traceRay,
                                                       const Accuracy& accuracy) {
-    (void)accuracy;  // knobs not wired yet
     auto lib = std::make_shared<ShaderLibrary>();
-    if (precision == Precision::Double) addExports<double>(*lib, traceRay);
-    else addExports<float>(*lib, traceRay);
+    if (precision == Precision::Double) addExports<double>(*lib, traceRay, accuracy);
+    else addExports<float>(*lib, traceRay, accuracy);
     return lib;
 }
 

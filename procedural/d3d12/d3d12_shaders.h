@@ -25,6 +25,7 @@
 #include "emulator/state_object.h"
 #include "procedural/accuracy.h"
 #include "procedural/math/fractals.h"
+#include "procedural/math/metaballs.h"
 #include "procedural/precision.h"
 #include "procedural/sample_layout.h"
 #include "procedural/trace_ray_parameters.h"
@@ -222,5 +223,22 @@ glm::vec<4, T> CalculatePhongLighting(const SceneConstantBuffer& sceneCB, glm::v
 // The "visibility falloff" of both closest hits: lerp(color, BackgroundColor, 1 - exp(-0.000002·t³)).
 template <typename T>
 glm::vec<4, T> ApplyVisibilityFalloff(glm::vec<4, T> color, T t);
+
+// ---- The accuracy knobs as the entry points pass them (procedural/accuracy.h) ------------------------
+// PORT: each value is a constant of the HLSL; Accuracy{} gives exactly those constants, so every march is the
+// HLSL's bit for bit. Factors multiply in T (scaledConstant), step counts round with scaledSteps.
+
+// MyIntersectionShader_SignedDistancePrimitive's sphere tracing: threshold 1e-4 x thresholdFactor,
+// 512 x stepsFactor steps, tetrahedral offset 0.5773e-4 x normalEpsilonFactor; stepScale is the material's.
+template <typename T>
+math::SphereTraceParams<T> sphereTraceParams(const Accuracy& accuracy, T stepScale);
+
+// MyIntersectionShader_VolumetricPrimitive's march: metaballSteps (128) samples, central-difference step
+// 0.5773e-5 x normalEpsilonFactor.
+template <typename T>
+math::MetaballsParams<T> metaballsParams(const Accuracy& accuracy);
+
+// MAX_RAY_RECURSION_DEPTH as the shaders use it: maxRecursionDepth, or the HLSL's 3.
+uint32_t maxRayRecursionDepth(const Accuracy& accuracy);
 
 }  // namespace refray::procedural::d3d12

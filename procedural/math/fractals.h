@@ -18,19 +18,23 @@ namespace refray::procedural::math {
 // =================================================================================================
 namespace mandelbulb {
 
+// The iterations of mdist's loop in the HLSL.
+inline constexpr int kIterations = 4;
+
 // Power-8 Mandelbulb DE with orbit trap; 4 iterations, bailout |w|^2 > 256.
 // resColor = (final m, trap.y, trap.z, trap.w), where trap = componentwise min over the
 // iterations of (|w.x|, |w.y|, |w.z|, m before the update). DE = 0.25*log(m)*sqrt(m)/dz.
 // At p = 0 the result is NaN (0/0 inside acos, H4); on the y axis atan2(0,0) = pi/2 (H5).
+// PORT: the loop count is the literal 4 in the HLSL; as a parameter it carries the mandelbulbIterations knob.
 template <typename T>
-T mdist(const vec3<T>& p, vec4<T>& resColor) {
+T mdist(const vec3<T>& p, vec4<T>& resColor, int iterations = kIterations) {
     vec3<T> w = p;
     T m = hlsl::dot(w, w);
 
     vec4<T> trap(hlsl::abs(w), m);
     T dz = T(1);
 
-    for (int i = 0; i < 4; i++) {
+    for (int i = 0; i < iterations; i++) {
         // The non-PERFORMANCE branch (the live one). Exponents 7 and 8 are not the literal 2, so
         // DXC lowers both pows to exp2(y*log2(x)).
         dz = T(8) * hlsl::pow(hlsl::sqrt(m), T(7)) * dz + T(1);
@@ -52,15 +56,16 @@ T mdist(const vec3<T>& p, vec4<T>& resColor) {
 }
 
 template <typename T>
-T mdist(const vec3<T>& p) {
+T mdist(const vec3<T>& p, int iterations = kIterations) {
     vec4<T> unused;
-    return mdist(p, unused);
+    return mdist(p, unused, iterations);
 }
 
 // Tetrahedral normal with offset 0.5773e-4 (the `t` argument of the HLSL is unused).
+// PORT: the offset and mdist's iterations are parameters (the normalEpsilonFactor and mandelbulbIterations knobs).
 template <typename T>
-vec3<T> calcNormal(const vec3<T>& pos) {
-    return sdCalculateNormal(pos, [](const vec3<T>& q) { return mdist(q); });
+vec3<T> calcNormal(const vec3<T>& pos, T offset = tetrahedralOffset<T>(), int iterations = kIterations) {
+    return sdCalculateNormal(pos, [iterations](const vec3<T>& q) { return mdist(q, iterations); }, offset);
 }
 
 // Step count iMax(time, instanceId): k = int((0.5*time^2 + instanceId) % 256) (truncated
@@ -76,6 +81,16 @@ int MandelbulbIterationCount(T time, int instanceId) {
     return iMax;
 }
 
+// The constants of MandelbulbDistance besides its step count; the defaults are the HLSL's.
+// PORT: constants in the HLSL; as parameters they carry the thresholdFactor, mandelbulbIterations and
+// normalEpsilonFactor knobs (procedural/accuracy.h).
+template <typename T>
+struct MandelbulbParams {
+    T threshold = T(0.0001);                  // hit when mdist < threshold * t
+    int iterations = kIterations;             // mdist's loop, in the march and the normal
+    T normalOffset = tetrahedralOffset<T>();  // calcNormal's tetrahedral offset
+};
+
 template <typename T>
 struct MandelbulbHit {
     bool hit = false;
@@ -89,9 +104,10 @@ struct MandelbulbHit {
 // [0, 1000]. Up to iMax steps: pos = ro + rd*t; break if t > dis.y or mdist(pos) < 1e-4*t;
 // t += h. Hit iff t < dis.y afterwards, converged or not. stepScale is ignored, as in the HLSL.
 // PORT: takes iMax (MandelbulbIterationCount) instead of (time, instanceId), and returns the
-// HLSL `out` thit/attr as a struct.
+// HLSL `out` thit/attr as a struct. PORT: `params` holds the HLSL's constants (MandelbulbParams).
 template <typename T>
-MandelbulbHit<T> MandelbulbDistance(const vec3<T>& ro, const vec3<T>& rd, int iMax) {
+MandelbulbHit<T> MandelbulbDistance(const vec3<T>& ro, const vec3<T>& rd, int iMax,
+                                    const MandelbulbParams<T>& params = {}) {
     MandelbulbHit<T> result;
 
     vec2<T> dis = isphere(vec4<T>(T(0), T(0), T(0), T(1.25)), ro, rd);
@@ -105,8 +121,8 @@ MandelbulbHit<T> MandelbulbDistance(const vec3<T>& ro, const vec3<T>& rd, int iM
 
     for (int i = 0; i < iMax; i++) {
         pos = ro + rd * t;
-        const T th = T(0.0001) * t;
-        const T h = mdist(pos, trap);
+        const T th = params.threshold * t;
+        const T h = mdist(pos, trap, params.iterations);
         if (t > dis.y || h < th) break;
         t += h;
     }
@@ -114,7 +130,7 @@ MandelbulbHit<T> MandelbulbDistance(const vec3<T>& ro, const vec3<T>& rd, int iM
     if (t < dis.y) {
         result.hit = true;
         result.thit = t;
-        result.normal = calcNormal(pos);
+        result.normal = calcNormal(pos, params.normalOffset, params.iterations);
         result.color = trap;
     }
     result.pos = pos;
@@ -130,6 +146,9 @@ namespace julia {
 
 template <typename T>
 inline constexpr T kPrecis = T(0.00025f);
+// jdist's iMax as raycast and calcNormal pass it, and raycast's march steps, in the HLSL.
+inline constexpr int kIterations = 200;
+inline constexpr int kMarchSteps = 1024;
 
 // kc = float4(-2, 6, 15, -6) / 22.
 template <typename T>
@@ -184,11 +203,16 @@ vec2<T> jdist(const vec3<T>& p, const vec4<T>& c, int iMax) {
     return vec2<T>(d, n);
 }
 
-// Tetrahedral normal with offset 0.5773*kPrecis on jdist(...).x.
+// calcNormal's tetrahedral offset, 0.5773*kPrecis (a product in T, as the HLSL computes it).
 template <typename T>
-vec3<T> calcNormal(const vec3<T>& pos, const vec4<T>& c = kc<T>(), int iMax = 200) {
-    return sdCalculateNormal(pos, [&c, iMax](const vec3<T>& q) { return jdist(q, c, iMax).x; },
-                             T(0.5773f) * kPrecis<T>);
+T calcNormalOffset() { return T(0.5773f) * kPrecis<T>; }
+
+// Tetrahedral normal with offset 0.5773*kPrecis on jdist(...).x.
+// PORT: the offset is a parameter (the normalEpsilonFactor knob).
+template <typename T>
+vec3<T> calcNormal(const vec3<T>& pos, const vec4<T>& c = kc<T>(), int iMax = kIterations,
+                   T offset = calcNormalOffset<T>()) {
+    return sdCalculateNormal(pos, [&c, iMax](const vec3<T>& q) { return jdist(q, c, iMax).x; }, offset);
 }
 
 // March in q-space between the cut planes y = deltaT and y = -1.1 inside the sphere of radius
@@ -196,9 +220,11 @@ vec3<T> calcNormal(const vec3<T>& pos, const vec4<T>& c = kc<T>(), int iMax = 20
 // secant step when lt > 9.9999997e-5 and the last d < 0. Returns (t, n) when t < tmax (running
 // out of steps counts as a hit, H15), (-1, n) when t >= tmax, and (-2, 0) when a plane or the
 // sphere rules it out. IEEE comparisons decide every branch (rd.y = 0, H10).
+// PORT: the step limit 1024 and the stop test's kPrecis are parameters (maxSteps, precis: the stepsFactor and
+// thresholdFactor knobs); tmin starts at kPrecis and the secant gate stays 9.9999997e-5 whatever precis is.
 template <typename T>
 vec2<T> raycast(const vec3<T>& ro, const vec3<T>& rd, const vec4<T>& c = kc<T>(), T deltaT = T(0),
-                int iMax = 200) {
+                int iMax = kIterations, int maxSteps = kMarchSteps, T precis = kPrecis<T>) {
     T tmax = T(7000);
     T tmin = kPrecis<T>;
 
@@ -231,9 +257,9 @@ vec2<T> raycast(const vec3<T>& ro, const vec3<T>& rd, const vec4<T>& c = kc<T>()
     T t = tmin;
     T lt = T(0);
     T lh = T(0);
-    for (int i = 0; i < 1024; i++) {
+    for (int i = 0; i < maxSteps; i++) {
         res = jdist(ro + (rd * t), c, iMax);
-        if (res.x < kPrecis<T>) break;
+        if (res.x < precis) break;
         lt = t;
         lh = res.x;
         t += hlsl::min(res.x, T(0.2));
@@ -249,6 +275,17 @@ vec2<T> raycast(const vec3<T>& ro, const vec3<T>& rd, const vec4<T>& c = kc<T>()
     return res;
 }
 
+// The constants JuliaDistance passes to raycast and calcNormal; the defaults are the HLSL's.
+// PORT: constants in the HLSL; as parameters they carry the juliaIterations, stepsFactor, thresholdFactor and
+// normalEpsilonFactor knobs (procedural/accuracy.h).
+template <typename T>
+struct JuliaParams {
+    int iterations = kIterations;            // jdist's iMax, in the march and the normal
+    int marchSteps = kMarchSteps;            // raycast's step limit
+    T precis = kPrecis<T>;                   // raycast's stop test res.x < precis
+    T normalOffset = calcNormalOffset<T>();  // calcNormal's tetrahedral offset
+};
+
 template <typename T>
 struct JuliaHit {
     bool hit = false;
@@ -259,18 +296,19 @@ struct JuliaHit {
 // Local ray -> q-space: ro' = 0.4*ro + (0, -1, 0), rd unchanged; raycast with the defaults
 // (kc, deltaT = 0, 200 iterations). Hit iff t >= 0.
 // PORT: the cut-animation variables (iMax from 10.5*time, deltaT) are computed and then ignored
-// by the HLSL; they are not ported, so there is no time parameter.
+// by the HLSL; they are not ported, so there is no time parameter. PORT: `params` holds the HLSL's
+// constants (JuliaParams).
 template <typename T>
-JuliaHit<T> JuliaDistance(vec3<T> ro, const vec3<T>& rd) {
+JuliaHit<T> JuliaDistance(vec3<T> ro, const vec3<T>& rd, const JuliaParams<T>& params = {}) {
     JuliaHit<T> result;
     ro *= T(0.4);
     ro.y += T(-1);
 
-    const vec2<T> tn = raycast(ro, rd);
+    const vec2<T> tn = raycast(ro, rd, kc<T>(), T(0), params.iterations, params.marchSteps, params.precis);
     const bool cond = (tn.x >= T(0));
     if (cond) {
         const vec3<T> pos = ro + (tn.x * rd);
-        result.normal = calcNormal(pos);
+        result.normal = calcNormal(pos, kc<T>(), params.iterations, params.normalOffset);
         result.resT = tn;
         result.hit = true;
     }

@@ -49,12 +49,16 @@ T CalculateMetaballsPotential(const vec3<T>& position, const Metaballs<T>& blobs
     return sumFieldPotential;
 }
 
-// Minus the central-difference gradient, normalised (points outward); e = 0.5773e-5.
-// A zero gradient gives a NaN normal (D3D12 H11).
+// The central-difference step of CalculateMetaballsNormal, e = 0.5773e-5. `0.5773 * 0.00001` is a literal-only
+// product: folded at full precision, then rounded.
 template <typename T>
-vec3<T> CalculateMetaballsNormal(const vec3<T>& position, const Metaballs<T>& blobs) {
-    // `0.5773 * 0.00001` is a literal-only product: folded at full precision, then rounded.
-    const T e = static_cast<T>(0.5773 * 0.00001);
+T metaballsNormalOffset() { return static_cast<T>(0.5773 * 0.00001); }
+
+// Minus the central-difference gradient, normalised (points outward); e = 0.5773e-5 by default.
+// A zero gradient gives a NaN normal (D3D12 H11).
+// PORT: e is a constant in the HLSL; as a parameter it carries the normalEpsilonFactor knob (procedural/accuracy.h).
+template <typename T>
+vec3<T> CalculateMetaballsNormal(const vec3<T>& position, const Metaballs<T>& blobs, T e = metaballsNormalOffset<T>()) {
     return hlsl::normalize(vec3<T>(CalculateMetaballsPotential(position + vec3<T>(-e, 0, 0), blobs) -
                                        CalculateMetaballsPotential(position + vec3<T>(e, 0, 0), blobs),
                                    CalculateMetaballsPotential(position + vec3<T>(0, -e, 0), blobs) -
@@ -101,6 +105,15 @@ void FindIntersectingMetaballs(const Ray<T>& ray, const RayExtent<T>& extent, T&
     tmax = hlsl::min(tmax, extent.tCurrent);
 }
 
+// The constants of RayMetaballsIntersectionTest; the defaults are the HLSL's.
+// PORT: constants in the HLSL; as parameters they carry the metaballSteps and normalEpsilonFactor knobs
+// (procedural/accuracy.h).
+template <typename T>
+struct MetaballsParams {
+    std::uint32_t maxSteps = 128;                 // MAX_STEPS: the samples, and the divisor of the step
+    T normalOffset = metaballsNormalOffset<T>();  // CalculateMetaballsNormal's e
+};
+
 template <typename T>
 struct MetaballsHit {
     bool hit = false;
@@ -109,13 +122,13 @@ struct MetaballsHit {
     std::uint32_t step = 0;  // 1-based index of the sample that hit
 };
 
-// 128 samples t = tmin + k*(tmax - tmin)/128; the first sample with potential >= 0.25 whose
+// MAX_STEPS (128) samples t = tmin + k*(tmax - tmin)/MAX_STEPS; the first sample with potential >= 0.25 whose
 // normal passes IsAValidHit is the hit (no refinement: up to one step inside the surface).
 // The step depends on TCurrent at call time (D3D12 H10); with no ball hit the samples are
 // inf/NaN and nothing is reported (H8).
 template <typename T>
 MetaballsHit<T> RayMetaballsIntersectionTest(const Ray<T>& ray, const RayExtent<T>& extent, T elapsedTime,
-                                             T cycleDuration = T(12)) {
+                                             T cycleDuration = T(12), const MetaballsParams<T>& params = {}) {
     MetaballsHit<T> result;
     const Metaballs<T> blobs = InitializeAnimatedMetaballs(elapsedTime, cycleDuration);
 
@@ -123,7 +136,7 @@ MetaballsHit<T> RayMetaballsIntersectionTest(const Ray<T>& ray, const RayExtent<
     T tmax = T(0);
     FindIntersectingMetaballs(ray, extent, tmin, tmax, blobs);
 
-    const std::uint32_t MAX_STEPS = 128;
+    const std::uint32_t MAX_STEPS = params.maxSteps;
     T t = tmin;
     const T minTStep = (tmax - tmin) / static_cast<T>(MAX_STEPS / 1);
     std::uint32_t iStep = 0;
@@ -138,7 +151,7 @@ MetaballsHit<T> RayMetaballsIntersectionTest(const Ray<T>& ray, const RayExtent<
 
         const T Threshold = T(0.25);
         if (sumFieldPotential >= Threshold) {
-            const vec3<T> normal = CalculateMetaballsNormal(position, blobs);
+            const vec3<T> normal = CalculateMetaballsNormal(position, blobs, params.normalOffset);
             if (IsAValidHit(ray, t, normal, extent)) {
                 result.hit = true;
                 result.thit = t;

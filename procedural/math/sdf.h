@@ -231,6 +231,9 @@ vec3<T> sdCalculateNormal(const vec3<T>& pos, Sdf&& sdf, T offset = tetrahedralO
 }
 
 // ---- Sphere tracing (RaySignedDistancePrimitiveTest) -------------------------------------------
+// The defaults are the HLSL's constants; stepScale is the material's l_materialCB.stepScale.
+// PORT: threshold, maxSteps and normalOffset are constants in the HLSL; as parameters they carry the shader
+// libraries' accuracy knobs (procedural/accuracy.h: thresholdFactor, stepsFactor, normalEpsilonFactor).
 template <typename T>
 struct SphereTraceParams {
     T threshold = T(0.0001);  // hit when distance <= threshold * t

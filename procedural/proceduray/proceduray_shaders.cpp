@@ -125,6 +125,54 @@ REFRAY_INSTANTIATE_HELPERS(float)
 REFRAY_INSTANTIATE_HELPERS(double)
 #undef REFRAY_INSTANTIATE_HELPERS
 
+// ---- Accuracy knobs --------------------------------------------------------------------------------
+
+template <typename T>
+math::SphereTraceParams<T> sphereTraceParams(const Accuracy& accuracy, T stepScale) {
+    math::SphereTraceParams<T> params;  // the HLSL's constants
+    params.threshold = scaledConstant(params.threshold, accuracy.thresholdFactor);
+    params.maxSteps = scaledSteps(params.maxSteps, accuracy.stepsFactor);
+    params.stepScale = stepScale;
+    params.normalOffset = scaledConstant(params.normalOffset, accuracy.normalEpsilonFactor);
+    return params;
+}
+
+template <typename T>
+math::mandelbulb::MandelbulbParams<T> mandelbulbParams(const Accuracy& accuracy) {
+    math::mandelbulb::MandelbulbParams<T> params;  // the HLSL's constants
+    params.threshold = scaledConstant(params.threshold, accuracy.thresholdFactor);
+    if (accuracy.mandelbulbIterations) params.iterations = hlslLoopCount(*accuracy.mandelbulbIterations);
+    params.normalOffset = scaledConstant(params.normalOffset, accuracy.normalEpsilonFactor);
+    return params;
+}
+
+int mandelbulbStepCount(int iMax, const Accuracy& accuracy) {
+    if (iMax < 1) return iMax;
+    return hlslLoopCount(scaledSteps(uint32_t(iMax), accuracy.stepsFactor));
+}
+
+template <typename T>
+math::julia::JuliaParams<T> juliaParams(const Accuracy& accuracy) {
+    math::julia::JuliaParams<T> params;  // the HLSL's constants
+    if (accuracy.juliaIterations) params.iterations = hlslLoopCount(*accuracy.juliaIterations);
+    params.marchSteps = hlslLoopCount(scaledSteps(uint32_t(params.marchSteps), accuracy.stepsFactor));
+    params.precis = scaledConstant(params.precis, accuracy.thresholdFactor);
+    params.normalOffset = scaledConstant(params.normalOffset, accuracy.normalEpsilonFactor);
+    return params;
+}
+
+uint32_t maxRayRecursionDepth(const Accuracy& accuracy) {
+    return accuracy.maxRecursionDepth.value_or(MAX_RAY_RECURSION_DEPTH);
+}
+
+#define REFRAY_INSTANTIATE_KNOBS(T)                                                                     \
+    template math::SphereTraceParams<T> sphereTraceParams<T>(const Accuracy&, T);                       \
+    template math::mandelbulb::MandelbulbParams<T> mandelbulbParams<T>(const Accuracy&);                \
+    template math::julia::JuliaParams<T> juliaParams<T>(const Accuracy&);
+REFRAY_INSTANTIATE_KNOBS(float)
+REFRAY_INSTANTIATE_KNOBS(double)
+#undef REFRAY_INSTANTIATE_KNOBS
+
 // ---- Shader-side helpers (Helpers.hlsli, RaytracingShaderHelper.hlsli) -----------------------------
 
 namespace {
@@ -224,10 +272,12 @@ tvec4<T> CalculatePhongLighting(const ShaderContext& ctx, const SceneConstantBuf
 // The RayDesc and the payload are the GPU interface: the ray is rounded to float on the way in.
 // PORT: the HLSL passes the constants kInstanceMask, <ray type>, RayTypeCount, <ray type>; here they come from
 // `traceRay` (the library's TraceRayArgumentSet, those same values by default), which every caller passes down.
+// PORT: MAX_RAY_RECURSION_DEPTH is the library's `maxDepth` (maxRayRecursionDepth of its Accuracy), passed down
+// the same way.
 template <typename T>
-tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const tvec3<T>& origin,
-                          const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
-    if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH) return tvec4<T>(T(0));
+tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
+                          const tvec3<T>& origin, const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
+    if (currentRayRecursionDepth >= maxDepth) return tvec4<T>(T(0));
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     RayPayload rayPayload{vec4(0.0f), currentRayRecursionDepth + 1, 0.0f, 0, 0};
     const TraceRayArguments& radiance = traceRay[Radiance];
@@ -239,9 +289,10 @@ tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRa
 }
 
 template <typename T>
-bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const tvec3<T>& origin,
-                                  const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
-    if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH) return false;
+bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
+                                  const tvec3<T>& origin, const tvec3<T>& direction,
+                                  uint32_t currentRayRecursionDepth) {
+    if (currentRayRecursionDepth >= maxDepth) return false;
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     // Starts as "hit": closest-hit and any-hit shaders are skipped, only Miss_Shadow clears it.
     ShadowRayPayload shadowPayload{0.0f, 1};
@@ -257,21 +308,21 @@ bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet&
 
 // The shadow test every lit closest hit starts with: from HitWorldPosition() towards the light.
 template <typename T>
-bool TraceShadowRayTowardsLight(ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
+bool TraceShadowRayTowardsLight(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
                                 const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth) {
     const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
-    return TraceShadowRayAndReportIfHit(ctx, traceRay, hitPosition,
+    return TraceShadowRayAndReportIfHit(ctx, traceRay, maxDepth, hitPosition,
                                         hlsl::normalize(tvec3<T>(g_sceneCB.lightPosition) - hitPosition),
                                         recursionDepth);
 }
 
 // reflectanceCoef·(Fresnel, 1)·(reflection ray colour), the reflection ray leaving HitWorldPosition().
 template <typename T>
-tvec4<T> ReflectedColor(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const tvec3<T>& normal,
-                        T reflectanceCoef, const tvec3<T>& f0, uint32_t recursionDepth) {
+tvec4<T> ReflectedColor(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
+                        const tvec3<T>& normal, T reflectanceCoef, const tvec3<T>& f0, uint32_t recursionDepth) {
     const tvec3<T> D = tvec3<T>(ctx.WorldRayDirection());
-    const tvec4<T> reflectionColor =
-        TraceRadianceRay(ctx, traceRay, HitWorldPosition<T>(ctx), hlsl::reflect(D, normal), recursionDepth);
+    const tvec4<T> reflectionColor = TraceRadianceRay(ctx, traceRay, maxDepth, HitWorldPosition<T>(ctx),
+                                                      hlsl::reflect(D, normal), recursionDepth);
     const tvec3<T> fresnelR = FresnelReflectanceSchlick(D, normal, f0);
     return reflectanceCoef * tvec4<T>(fresnelR, T(1)) * reflectionColor;
 }
@@ -291,10 +342,11 @@ constexpr ProceduralPrimitiveAttributes kInitialAttributes{vec3(0.0f), vec4(0.0f
 
 // ---- Entry points ----------------------------------------------------------------------------------
 // Each is a template on the scalar type; results are rounded to float where they cross the interface. Those that
-// trace rays take the library's TraceRay arguments (PORT: constants in the HLSL).
+// trace rays take the library's TraceRay arguments, and those that march or recurse its Accuracy (PORT: constants
+// in the HLSL).
 
 template <typename T>
-void Raygen(ShaderContext& ctx, const TraceRayArgumentSet& traceRay) {
+void Raygen(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const uvec3 index = ctx.DispatchRaysIndex();
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
@@ -302,7 +354,8 @@ void Raygen(ShaderContext& ctx, const TraceRayArgumentSet& traceRay) {
     GenerateCameraRay(uvec2(index), uvec2(ctx.DispatchRaysDimensions()), tvec3<T>(g_sceneCB.cameraPosition),
                       g_sceneCB.projectionToWorld, origin, direction);
     const uint32_t currentRecursionDepth = 0;
-    const tvec4<T> color = TraceRadianceRay(ctx, traceRay, origin, direction, currentRecursionDepth);
+    const tvec4<T> color =
+        TraceRadianceRay(ctx, traceRay, maxRayRecursionDepth(accuracy), origin, direction, currentRecursionDepth);
     // PORT: the texture stores floats; the R8G8B8A8_UNORM conversion happens when the image is written out.
     ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView)).at(index.x, index.y) = vec4(color);
 }
@@ -319,8 +372,8 @@ void Miss_Shadow(ShaderContext&, ShadowRayPayload& rayPayload) {
 }
 
 template <typename T>
-void ClosestHit_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, RayPayload& rayPayload,
-                         const BuiltInTriangleIntersectionAttributes&) {
+void ClosestHit_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                         RayPayload& rayPayload, const BuiltInTriangleIntersectionAttributes&) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     if (g_sceneCB.debugFlag) {
@@ -343,12 +396,14 @@ void ClosestHit_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay
         ctx.loadFromTable<Vertex>(vertexBuffers, /*g_vertices*/ 1, uint64_t(indices[0]) * sizeof(Vertex)).normal;
     const tvec3<T> triangleNormal = -tvec3<T>(storedNormal);
 
-    const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, traceRay, g_sceneCB, rayPayload.recursionDepth);
+    const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
+    const bool shadowRayHit =
+        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, g_sceneCB, rayPayload.recursionDepth);
 
     const tvec4<T> albedo = tvec4<T>(l_materialCB.albedo);
     tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, traceRay, triangleNormal, T(l_materialCB.reflectanceCoef),
+        reflectedColor = ReflectedColor(ctx, traceRay, maxDepth, triangleNormal, T(l_materialCB.reflectanceCoef),
                                         tvec3<T>(albedo), rayPayload.recursionDepth);
 
     const tvec4<T> phongColor =
@@ -361,7 +416,7 @@ void ClosestHit_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay
 }
 
 template <typename T>
-void Intersection_Pacman(ShaderContext& ctx) {
+void Intersection_Pacman(ShaderContext& ctx, const Accuracy& accuracy) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx);
     const auto primitiveType = SignedDistancePrimitive(aabbCB(ctx).primitiveType);
@@ -374,8 +429,8 @@ void Intersection_Pacman(ShaderContext& ctx) {
     }
 
     const T mouth = math::pacman::PacmanMouthInterpolant(T(g_sceneCB.elapsedTime));
-    math::SphereTraceParams<T> params;
-    params.stepScale = T(materialCB(ctx).stepScale);
+    // PORT: the march's threshold, step limit and normal offset come from the library's Accuracy.
+    const math::SphereTraceParams<T> params = sphereTraceParams(accuracy, T(materialCB(ctx).stepScale));
     const auto sdf = [primitiveType, mouth](const tvec3<T>& p) {
         return GetDistanceFromSignedDistancePrimitive(p, primitiveType, mouth);
     };
@@ -391,8 +446,8 @@ void Intersection_Pacman(ShaderContext& ctx) {
 }
 
 template <typename T>
-void ClosestHit_Pacman(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, RayPayload& rayPayload,
-                       const ProceduralPrimitiveAttributes& attr) {
+void ClosestHit_Pacman(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                       RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
     [[maybe_unused]] PrecisionScope<T> scope;
     if (ctx.HitKind() == 1) {
         rayPayload.color = vec4(0.0f, 0.0f, 1.0f, 0.0f);
@@ -403,12 +458,14 @@ void ClosestHit_Pacman(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, 
     const tvec3<T> normal = tvec3<T>(attr.normal);
     const tvec4<T> albedo = tvec4<T>(l_materialCB.albedo);
 
-    const bool shadowRayHit = TraceShadowRayTowardsLight<T>(ctx, traceRay, g_sceneCB, rayPayload.recursionDepth);
+    const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
+    const bool shadowRayHit =
+        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, g_sceneCB, rayPayload.recursionDepth);
 
     tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, traceRay, normal, T(l_materialCB.reflectanceCoef), tvec3<T>(albedo),
-                                        rayPayload.recursionDepth);
+        reflectedColor = ReflectedColor(ctx, traceRay, maxDepth, normal, T(l_materialCB.reflectanceCoef),
+                                        tvec3<T>(albedo), rayPayload.recursionDepth);
 
     const tvec4<T> phongColor =
         CalculatePhongLighting(ctx, g_sceneCB, albedo, normal, shadowRayHit, T(l_materialCB.diffuseCoef),
@@ -420,7 +477,7 @@ void ClosestHit_Pacman(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, 
 }
 
 template <typename T>
-void Intersection_Mandelbulb(ShaderContext& ctx) {
+void Intersection_Mandelbulb(ShaderContext& ctx, const Accuracy& accuracy) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx);
     ProceduralPrimitiveAttributes attr = kInitialAttributes;
@@ -433,10 +490,13 @@ void Intersection_Mandelbulb(ShaderContext& ctx) {
 
     // The step count animates with time and the procedural instance ordinal (not InstanceIndex()).
     // l_materialCB.stepScale is passed by the HLSL but never used, so it is not read here.
-    const int iMax =
-        math::mandelbulb::MandelbulbIterationCount(T(g_sceneCB.elapsedTime), int(aabbCB(ctx).instanceIndex));
+    // PORT: the step count is scaled, and the threshold, iterations and normal offset come, from the library's
+    // Accuracy.
+    const int iMax = mandelbulbStepCount(
+        math::mandelbulb::MandelbulbIterationCount(T(g_sceneCB.elapsedTime), int(aabbCB(ctx).instanceIndex)),
+        accuracy);
     const math::mandelbulb::MandelbulbHit<T> primitiveTest =
-        math::mandelbulb::MandelbulbDistance(localRay.origin, localRay.direction, iMax);
+        math::mandelbulb::MandelbulbDistance(localRay.origin, localRay.direction, iMax, mandelbulbParams<T>(accuracy));
 
     if (primitiveTest.hit && primitiveTest.thit < T(ctx.RayTCurrent())) {
         attr.color = vec4(primitiveTest.color);
@@ -446,8 +506,8 @@ void Intersection_Mandelbulb(ShaderContext& ctx) {
 }
 
 template <typename T>
-void ClosestHit_Mandelbulb(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, RayPayload& rayPayload,
-                           const ProceduralPrimitiveAttributes& attr) {
+void ClosestHit_Mandelbulb(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                           RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
     [[maybe_unused]] PrecisionScope<T> scope;
     if (ctx.HitKind() == 1) {
         rayPayload.color = vec4(0.0f, 1.0f, 0.0f, 0.0f);
@@ -460,8 +520,9 @@ void ClosestHit_Mandelbulb(ShaderContext& ctx, const TraceRayArgumentSet& traceR
 
     tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, traceRay, normal, T(l_materialCB.reflectanceCoef),
-                                        tvec3<T>(vec3(l_materialCB.albedo)), rayPayload.recursionDepth);
+        reflectedColor =
+            ReflectedColor(ctx, traceRay, maxRayRecursionDepth(accuracy), normal, T(l_materialCB.reflectanceCoef),
+                           tvec3<T>(vec3(l_materialCB.albedo)), rayPayload.recursionDepth);
 
     color = color + reflectedColor;
     color += tvec4<T>(rayPayload.color);
@@ -470,7 +531,7 @@ void ClosestHit_Mandelbulb(ShaderContext& ctx, const TraceRayArgumentSet& traceR
 }
 
 template <typename T>
-void Intersection_Julia(ShaderContext& ctx) {
+void Intersection_Julia(ShaderContext& ctx, const Accuracy& accuracy) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx);
     ProceduralPrimitiveAttributes attr = kInitialAttributes;
@@ -482,7 +543,9 @@ void Intersection_Julia(ShaderContext& ctx) {
     }
 
     // PORT: JuliaDistance takes no time; the HLSL's cut animation is computed and then ignored (§5.5).
-    const math::julia::JuliaHit<T> primitiveTest = math::julia::JuliaDistance(localRay.origin, localRay.direction);
+    // PORT: the iterations, march steps, stop precision and normal offset come from the library's Accuracy.
+    const math::julia::JuliaHit<T> primitiveTest =
+        math::julia::JuliaDistance(localRay.origin, localRay.direction, juliaParams<T>(accuracy));
     const tvec2<T> thit = primitiveTest.resT;
 
     // H1: thit.x is in q-space units (0.4 x normalised local units).
@@ -494,8 +557,8 @@ void Intersection_Julia(ShaderContext& ctx) {
 }
 
 template <typename T>
-void ClosestHit_Julia(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, RayPayload& rayPayload,
-                      const ProceduralPrimitiveAttributes& attr) {
+void ClosestHit_Julia(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                      RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     if (g_sceneCB.debugFlag) {
@@ -509,15 +572,17 @@ void ClosestHit_Julia(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, R
 
     // H1: with the local-unit t this point lies near the object-space ray origin, not on the surface.
     const tvec3<T> pos = tvec3<T>(ctx.ObjectRayOrigin()) + T(ctx.RayTCurrent()) * tvec3<T>(ctx.ObjectRayDirection());
+    // PORT: MAX_RAY_RECURSION_DEPTH is the library's (maxRayRecursionDepth); with 0 the subtraction wraps, as the
+    // HLSL's unsigned comparison does.
+    const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
     tvec4<T> albedo = tvec4<T>(T(3.5f) * colorSurface(pos, tvec2<T>(attr.color)), T(1));
-    if (rayPayload.recursionDepth == MAX_RAY_RECURSION_DEPTH - 1)
-        albedo += T(1.65f) * hlsl::step(T(0), hlsl::abs(pos.y));
+    if (rayPayload.recursionDepth == maxDepth - 1) albedo += T(1.65f) * hlsl::step(T(0), hlsl::abs(pos.y));
 
     const T reflecCoef = T(0.1f);
     tvec4<T> reflectedColor(T(0));
     if (reflecCoef > T(0.001f))
-        reflectedColor =
-            ReflectedColor(ctx, traceRay, normal, reflecCoef, tvec3<T>(albedo), rayPayload.recursionDepth);
+        reflectedColor = ReflectedColor(ctx, traceRay, maxDepth, normal, reflecCoef, tvec3<T>(albedo),
+                                        rayPayload.recursionDepth);
 
     const T diffuseCoef = T(0.6f);
     const T specularCoef = T(0.08f);
@@ -529,38 +594,38 @@ void ClosestHit_Julia(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, R
     rayPayload.color = vec4(color);
 }
 
-// Every export, with its math in T. The lambdas hold a copy of the TraceRay arguments, which the shaders that
-// trace rays take by reference.
+// Every export, with its math in T. The lambdas hold copies of the TraceRay arguments and the Accuracy, which the
+// shaders take by reference.
 template <typename T>
-void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay) {
-    lib.addRayGeneration("Raygen", [traceRay](ShaderContext& ctx) { Raygen<T>(ctx, traceRay); });
+void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy) {
+    lib.addRayGeneration("Raygen", [traceRay, accuracy](ShaderContext& ctx) { Raygen<T>(ctx, traceRay, accuracy); });
     lib.addMiss<RayPayload>("Miss", Miss);
     lib.addMiss<ShadowRayPayload>("Miss_Shadow", Miss_Shadow);
     lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
-        "ClosestHit_Triangle",
-        [traceRay](ShaderContext& ctx, RayPayload& payload, const BuiltInTriangleIntersectionAttributes& attr) {
-            ClosestHit_Triangle<T>(ctx, traceRay, payload, attr);
+        "ClosestHit_Triangle", [traceRay, accuracy](ShaderContext& ctx, RayPayload& payload,
+                                                    const BuiltInTriangleIntersectionAttributes& attr) {
+            ClosestHit_Triangle<T>(ctx, traceRay, accuracy, payload, attr);
         });
-    lib.addIntersection<ProceduralPrimitiveAttributes>("Intersection_Julia",
-                                                       [](ShaderContext& ctx) { Intersection_Julia<T>(ctx); });
+    lib.addIntersection<ProceduralPrimitiveAttributes>(
+        "Intersection_Julia", [accuracy](ShaderContext& ctx) { Intersection_Julia<T>(ctx, accuracy); });
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Julia",
-        [traceRay](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
-            ClosestHit_Julia<T>(ctx, traceRay, payload, attr);
+        [traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
+            ClosestHit_Julia<T>(ctx, traceRay, accuracy, payload, attr);
         });
-    lib.addIntersection<ProceduralPrimitiveAttributes>("Intersection_Pacman",
-                                                       [](ShaderContext& ctx) { Intersection_Pacman<T>(ctx); });
+    lib.addIntersection<ProceduralPrimitiveAttributes>(
+        "Intersection_Pacman", [accuracy](ShaderContext& ctx) { Intersection_Pacman<T>(ctx, accuracy); });
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Pacman",
-        [traceRay](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
-            ClosestHit_Pacman<T>(ctx, traceRay, payload, attr);
+        [traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
+            ClosestHit_Pacman<T>(ctx, traceRay, accuracy, payload, attr);
         });
-    lib.addIntersection<ProceduralPrimitiveAttributes>("Intersection_Mandelbulb",
-                                                       [](ShaderContext& ctx) { Intersection_Mandelbulb<T>(ctx); });
+    lib.addIntersection<ProceduralPrimitiveAttributes>(
+        "Intersection_Mandelbulb", [accuracy](ShaderContext& ctx) { Intersection_Mandelbulb<T>(ctx, accuracy); });
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Mandelbulb",
-        [traceRay](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
-            ClosestHit_Mandelbulb<T>(ctx, traceRay, payload, attr);
+        [traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
+            ClosestHit_Mandelbulb<T>(ctx, traceRay, accuracy, payload, attr);
         });
 }
 
@@ -568,10 +633,9 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay) {
 
 std::shared_ptr<ShaderLibrary> makeProcedurayShaderLibrary(Precision precision, const TraceRayArgumentSet& traceRay,
                                                       const Accuracy& accuracy) {
-    (void)accuracy;  // knobs not wired yet
     auto lib = std::make_shared<ShaderLibrary>();
-    if (precision == Precision::Double) addExports<double>(*lib, traceRay);
-    else addExports<float>(*lib, traceRay);
+    if (precision == Precision::Double) addExports<double>(*lib, traceRay, accuracy);
+    else addExports<float>(*lib, traceRay, accuracy);
     return lib;
 }
 

@@ -23,6 +23,7 @@
 #include "emulator/root_signature.h"
 #include "emulator/state_object.h"
 #include "procedural/accuracy.h"
+#include "procedural/math/fractals.h"
 #include "procedural/precision.h"
 #include "procedural/sample_layout.h"
 #include "procedural/trace_ray_parameters.h"
@@ -178,5 +179,31 @@ glm::vec<3, T> colorSurface(glm::vec<3, T> pos, glm::vec<2, T> tn);
 // D = WorldRayDirection(), N = attr.normal, trap = attr.color.
 template <typename T>
 glm::vec<4, T> MandelbulbSurfaceColor(glm::vec<3, T> D, glm::vec<3, T> N, glm::vec<4, T> trap);
+
+// ---- The accuracy knobs as the entry points pass them (procedural/accuracy.h) ----------------------
+// PORT: each value is a constant of the HLSL; Accuracy{} gives exactly those constants, so every march is the
+// HLSL's bit for bit. Factors multiply in T (scaledConstant), step counts round with scaledSteps.
+
+// Intersection_Pacman's sphere tracing: threshold 1e-4 x thresholdFactor, 512 x stepsFactor steps, tetrahedral
+// offset 0.5773e-4 x normalEpsilonFactor; stepScale is the material's.
+template <typename T>
+math::SphereTraceParams<T> sphereTraceParams(const Accuracy& accuracy, T stepScale);
+
+// Intersection_Mandelbulb's march: threshold 1e-4 x thresholdFactor, mandelbulbIterations (4), tetrahedral offset
+// 0.5773e-4 x normalEpsilonFactor.
+template <typename T>
+math::mandelbulb::MandelbulbParams<T> mandelbulbParams(const Accuracy& accuracy);
+
+// The animated step count iMax (MandelbulbIterationCount) x stepsFactor; a count below 1 is left as it is (the
+// march does not run either way).
+int mandelbulbStepCount(int iMax, const Accuracy& accuracy);
+
+// Intersection_Julia's raycast and normal: juliaIterations (200), 1024 x stepsFactor march steps, the stop test's
+// precis 0.00025 x thresholdFactor, the normal offset 0.5773 x 0.00025 x normalEpsilonFactor.
+template <typename T>
+math::julia::JuliaParams<T> juliaParams(const Accuracy& accuracy);
+
+// MAX_RAY_RECURSION_DEPTH as the shaders use it: maxRecursionDepth, or the HLSL's 3.
+uint32_t maxRayRecursionDepth(const Accuracy& accuracy);
 
 }  // namespace refray::procedural::proceduray

@@ -24,3 +24,12 @@ TEST(Strings, QuotesHexAndNamespaces) {
     EXPECT_EQ(withoutNamespace("refray::procedural::d3d12::RayPayload"), "RayPayload");
     EXPECT_EQ(withoutNamespace("RayPayload"), "RayPayload");
 }
+
+TEST(Strings, ShellQuotedWordsSurviveTheShell) {
+    EXPECT_EQ(shellQuoted("steps=0.5"), "steps=0.5");
+    EXPECT_EQ(shellQuoted("/tmp/a-b/c_d.json"), "/tmp/a-b/c_d.json");
+    EXPECT_EQ(shellQuoted("my dir"), "'my dir'");
+    EXPECT_EQ(shellQuoted("it's"), "'it'\\''s'");
+    EXPECT_EQ(shellQuoted(""), "''");
+    EXPECT_EQ(shellQuoted("$HOME"), "'$HOME'");
+}

@@ -1,0 +1,278 @@
+#include "scenes/sweep.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "core/error.h"
+#include "core/json.h"
+#include "core/json_writer.h"
+#include "core/strings.h"
+#include "scenes/knobs.h"
+#include "scenes/scene.h"
+#include "scenes/sweep_report.h"
+
+namespace refray::scenes {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kPlanFormat = "refray-sweep-plan/1";
+constexpr const char* kRunFormat = "refray-sweep-run/1";
+
+void writeText(const fs::path& path, const std::string& text) {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+    out.close();
+    REFRAY_CHECK(out, "cannot write " << path.string());
+}
+
+std::string hostName() {
+    char name[256] = {};
+    if (gethostname(name, sizeof name - 1) != 0) return "unknown";
+    return name;
+}
+
+double median(std::vector<double> values) {
+    if (values.empty()) return 0.0;
+    std::sort(values.begin(), values.end());
+    const size_t n = values.size();
+    return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+// The settings of a plan's render before any knob: size, camera, time, threads.
+RenderSettings baseSettings(const SweepPlan& plan) {
+    RenderSettings s;
+    s.width = plan.width;
+    s.height = plan.height;
+    s.threads = plan.threads;
+    s.camera = plan.camera;
+    s.time = plan.time;
+    return s;
+}
+
+RenderSettings runSettings(const SweepPlan& plan, const SweepRun& run) {
+    RenderSettings s = baseSettings(plan);
+    if (run.settings != "defaults") applyKnobList(s, run.settings);
+    return s;
+}
+
+const SweepRun& findRun(const std::vector<SweepRun>& runs, const std::string& id, const fs::path& dir) {
+    for (const SweepRun& r : runs)
+        if (r.id == id) return r;
+    std::vector<std::string> ids;
+    for (const SweepRun& r : runs) ids.push_back(r.id);
+    throw Error("the sweep in " + dir.string() + " has no run " + inQuotes(id) + didYouMean(id, ids) +
+                "; its runs: " + joined(ids));
+}
+
+fs::path runImagePath(const fs::path& dir, const std::string& id) { return dir / "runs" / (id + ".exr"); }
+fs::path runJsonPath(const fs::path& dir, const std::string& id) { return dir / "runs" / (id + ".json"); }
+
+SweepTiming readTiming(const fs::path& path) {
+    const json::Value root = json::parseFile(path);
+    json::ObjectReader r(root, "a sweep run");
+    const json::Value& format = r.required("format");
+    if (format.asString() != kRunFormat) format.fail("expected format " + inQuotes(kRunFormat));
+    SweepTiming t;
+    t.id = r.required("id").asString();
+    r.required("settings");
+    for (const json::Value& s : r.required("seconds").asArray()) t.seconds.push_back(s.asNumber());
+    t.medianSeconds = r.required("medianSeconds").asNumber();
+    t.threads = r.required("threads").asUint32();
+    t.host = r.required("host").asString();
+    t.warnings = uint64_t(r.required("warnings").asInt());
+    r.finish();
+    return t;
+}
+
+}  // namespace
+
+std::vector<SweepRun> planRuns(const SweepPlan& plan) {
+    RenderSettings reference = baseSettings(plan);
+    applyKnobList(reference, plan.reference);
+    auto sameSampling = [&](uint32_t spp) {
+        return spp == reference.spp ? std::string("reference") : "reference-spp" + std::to_string(spp);
+    };
+
+    std::vector<SweepRun> rows = {{"defaults", "", "", "defaults", sameSampling(1)}};
+    std::set<std::string> seen = {"defaults"};
+    std::set<uint32_t> samplings = {1};
+    for (const SweepKnob& k : plan.knobs) {
+        REFRAY_CHECK(!k.values.empty(), "knob " << k.name << " has no values to sweep (write --knob " << k.name
+                                                << "=v1,v2,...)");
+        for (const std::string& v : k.values) {
+            RenderSettings s = baseSettings(plan);
+            applyKnob(s, k.name, v);
+            const std::string settings = describeKnobs(s);
+            if (!seen.insert(settings).second) continue;  // the default value, or a repeat
+            rows.push_back({settings, k.name, knobValue(s, k.name), settings, sameSampling(s.spp)});
+            samplings.insert(s.spp);
+        }
+    }
+
+    std::vector<SweepRun> runs = {{"reference", "", "", describeKnobs(reference), ""}};
+    for (uint32_t spp : samplings) {
+        if (spp == reference.spp) continue;
+        RenderSettings s = reference;
+        s.spp = spp;
+        runs.push_back({sameSampling(spp), "", "", describeKnobs(s), ""});
+    }
+    runs.insert(runs.end(), rows.begin(), rows.end());
+    return runs;
+}
+
+void writeSweepPlan(const fs::path& dir, SweepPlan plan) {
+    if (plan.threads == 0) plan.threads = std::max(1u, std::thread::hardware_concurrency());
+    REFRAY_CHECK(plan.repeats >= 1, "--repeats must be at least 1");
+    planRuns(plan);  // validates every knob and value before anything is written
+    fs::create_directories(dir / "runs");
+    json::Writer w;
+    w.beginObject();
+    w.member("format", kPlanFormat);
+    w.member("scene", plan.scene.string());
+    w.member("camera", plan.camera);
+    if (plan.time) w.member("time", *plan.time);
+    w.member("width", plan.width).member("height", plan.height);
+    w.member("threads", plan.threads).member("repeats", plan.repeats);
+    w.member("reference", plan.reference);
+    w.key("knobs").beginArray();
+    for (const SweepKnob& k : plan.knobs) {
+        w.beginObject(json::Writer::Layout::Inline).member("name", k.name).key("values");
+        w.beginArray(json::Writer::Layout::Inline);
+        for (const std::string& v : k.values) w.value(v);
+        w.endArray().endObject();
+    }
+    w.endArray().endObject();
+    writeText(dir / "plan.json", w.text() + "\n");
+}
+
+SweepPlan readSweepPlan(const fs::path& dir) {
+    const fs::path path = dir / "plan.json";
+    REFRAY_CHECK(fs::exists(path), dir.string() << " holds no sweep (no plan.json); write one with 'refray sweep SCENE "
+                                                   "--knob ... --emit-jobs FILE -o "
+                                                << dir.string() << "'");
+    const json::Value root = json::parseFile(path);
+    json::ObjectReader r(root, "the sweep plan");
+    const json::Value& format = r.required("format");
+    if (format.asString() != kPlanFormat) format.fail("expected format " + inQuotes(kPlanFormat));
+    SweepPlan plan;
+    plan.scene = r.required("scene").asString();
+    plan.camera = r.required("camera").asString();
+    if (const json::Value* t = r.optional("time")) plan.time = t->asFloat();
+    plan.width = r.required("width").asUint32();
+    plan.height = r.required("height").asUint32();
+    plan.threads = r.required("threads").asUint32();
+    plan.repeats = r.required("repeats").asUint32();
+    plan.reference = r.required("reference").asString();
+    for (const json::Value& v : r.required("knobs").asArray()) {
+        json::ObjectReader k(v, "a swept knob");
+        SweepKnob knob;
+        knob.name = k.required("name").asString();
+        for (const json::Value& value : k.required("values").asArray()) knob.values.push_back(value.asString());
+        k.finish();
+        plan.knobs.push_back(std::move(knob));
+    }
+    r.finish();
+    return plan;
+}
+
+uint64_t sweepJobUnits(const SweepPlan& plan, const SweepRun& run) {
+    return uint64_t(run.isReference() ? 1 : plan.repeats) * runSettings(plan, run).spp;
+}
+
+SweepTiming runSweepJob(const fs::path& dir, const std::string& id, Progress* progress) {
+    const SweepPlan plan = readSweepPlan(dir);
+    const std::vector<SweepRun> runs = planRuns(plan);
+    const SweepRun& run = findRun(runs, id, dir);
+    RenderSettings settings = runSettings(plan, run);
+    std::unique_ptr<Scene> scene = loadScene(plan.scene);
+
+    SweepTiming timing;
+    timing.id = id;
+    timing.threads = plan.threads;
+    timing.host = hostName();
+    const uint64_t renders = sweepJobUnits(plan, run) / settings.spp;
+    RenderResult result;
+    for (uint32_t i = 0; i < renders; ++i) {
+        const auto start = std::chrono::steady_clock::now();
+        result = scene->render(settings);
+        timing.seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        if (progress) progress->advance(settings.spp);
+    }
+    timing.medianSeconds = median(timing.seconds);
+    timing.warnings = result.dispatch.diagnostics.warnings().size();
+
+    fs::create_directories(dir / "runs");
+    result.image.metadata["sweep_run"] = id;
+    writeImage(runImagePath(dir, id).string(), result.image);
+    json::Writer w;
+    w.beginObject();
+    w.member("format", kRunFormat).member("id", id).member("settings", run.settings);
+    w.key("seconds").beginArray(json::Writer::Layout::Inline);
+    for (double s : timing.seconds) w.value(s);
+    w.endArray();
+    w.member("medianSeconds", timing.medianSeconds).member("threads", timing.threads).member("host", timing.host);
+    w.member("warnings", timing.warnings);
+    w.endObject();
+    writeText(runJsonPath(dir, id), w.text() + "\n");
+    return timing;
+}
+
+std::vector<std::string> sweepJobCommands(const fs::path& dir, const std::string& executable) {
+    std::vector<std::string> lines;
+    for (const SweepRun& r : planRuns(readSweepPlan(dir)))
+        lines.push_back(shellQuoted(executable) + " sweep --job " + shellQuoted(r.id) + " -o " + shellQuoted(dir.string()));
+    return lines;
+}
+
+SweepReport collectSweep(const fs::path& dir) {
+    SweepReport report;
+    report.plan = readSweepPlan(dir);
+    const std::vector<SweepRun> runs = planRuns(report.plan);
+    const SweepRun& defaults = findRun(runs, "defaults", dir);
+    for (const std::string& required : {std::string("reference"), defaults.sameSamplingReference, defaults.id})
+        REFRAY_CHECK(fs::exists(runJsonPath(dir, required)),
+                     "the sweep in " << dir.string() << " has no " << required << " run yet ("
+                                     << runJsonPath(dir, required).string() << "); run its job first");
+    report.referenceTiming = readTiming(runJsonPath(dir, "reference"));
+    std::map<std::string, Image> references;
+    auto errorAgainst = [&](const std::string& referenceId, const Image& image) {
+        auto it = references.find(referenceId);
+        if (it == references.end()) it = references.emplace(referenceId, readImage(runImagePath(dir, referenceId).string())).first;
+        SweepError e{compareImages(it->second, image, CompareThresholds{}),
+                     compareImages(it->second, image, CompareThresholds::golden())};
+        e.idiff.diffImage = Image();  // the report keeps numbers only
+        e.golden.diffImage = Image();
+        return e;
+    };
+    std::set<std::string> missing;
+    for (const SweepRun& run : runs)
+        if (!fs::exists(runJsonPath(dir, run.id)) || !fs::exists(runImagePath(dir, run.id))) missing.insert(run.id);
+    for (const SweepRun& run : runs) {
+        if (missing.count(run.id)) report.missing.push_back(run.id);
+        if (run.isReference() || missing.count(run.id) || missing.count(run.sameSamplingReference)) continue;
+        SweepRow row;
+        row.run = run;
+        row.timing = readTiming(runJsonPath(dir, run.id));
+        const Image image = readImage(runImagePath(dir, run.id).string());
+        row.total = errorAgainst("reference", image);
+        row.numerical = errorAgainst(run.sameSamplingReference, image);
+        report.rows.push_back(std::move(row));
+    }
+    markParetoFronts(report);
+    report.goldenSettings = cheapestPassing(report);
+    report.plots = writeSweepPlots(dir, report);
+    writeText(dir / "sweep.csv", sweepCsv(report));
+    writeText(dir / "sweep.md", sweepMarkdown(report));
+    return report;
+}
+
+}  // namespace refray::scenes
