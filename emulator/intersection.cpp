@@ -48,6 +48,11 @@ std::optional<TriangleIntersection> intersectTriangle(vec3 org, vec3 dir, vec3 v
         W = double(Bx) * double(Ay) - double(By) * double(Ax);
     }
     if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return std::nullopt;
+    // DEGEN-7: a triangle with collinear vertices is inactive. For oblique rays the float shear above can round
+    // such a triangle into a sliver with a non-zero determinant, so zero area is decided from the vertices
+    // themselves (in double; only rays that passed the edge tests pay for it).
+    const glm::dvec3 area = glm::cross(glm::dvec3(v1) - glm::dvec3(v0), glm::dvec3(v2) - glm::dvec3(v0));
+    if (area.x == 0.0 && area.y == 0.0 && area.z == 0.0) return std::nullopt;
     const double det = U + V + W;
     if (det == 0.0 || std::isnan(det)) return std::nullopt;
 

@@ -21,10 +21,9 @@
 namespace refray::scenes {
 
 // The reference's settings unless --reference gives others: double precision, 8x the march steps, a quarter of the
-// thresholds, twice the fractal iterations, 8x the metaball samples, twice the recursion depth, 16 samples per pixel.
-inline constexpr const char* kDefaultSweepReference =
-    "precision=double,steps=8,threshold=0.25,mandelbulb-iterations=8,julia-iterations=400,metaball-steps=1024,"
-    "recursion-depth=6,spp=16";
+// thresholds, 8x the metaball samples and 16 samples per pixel. Fractal iterations and the recursion depth stay the
+// HLSL's: they define the surface and the number of bounces the scene shows, which the approximations converge to.
+inline constexpr const char* kDefaultSweepReference = "precision=double,steps=8,threshold=0.25,metaball-steps=1024,spp=16";
 
 struct SweepKnob {
     std::string name;                 // a knob of scenes/knobs.h

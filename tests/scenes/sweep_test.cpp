@@ -110,12 +110,8 @@ TEST(Sweep, PlanHasOneReferencePerSamplingAndNoDuplicateRows) {
     for (const SweepRun& r : runs) ids.push_back(r.id);
     EXPECT_EQ(ids, (std::vector<std::string>{"reference", "reference-spp1", "reference-spp4", "defaults", "spp=4",
                                              "precision=double", "steps=0.01"}));
-    EXPECT_EQ(runs[0].settings,
-              "steps=8,threshold=0.25,mandelbulb-iterations=8,julia-iterations=400,metaball-steps=1024,"
-              "recursion-depth=6,spp=16,precision=double");
-    EXPECT_EQ(runs[1].settings,
-              "steps=8,threshold=0.25,mandelbulb-iterations=8,julia-iterations=400,metaball-steps=1024,"
-              "recursion-depth=6,precision=double");
+    EXPECT_EQ(runs[0].settings, "steps=8,threshold=0.25,metaball-steps=1024,spp=16,precision=double");
+    EXPECT_EQ(runs[1].settings, "steps=8,threshold=0.25,metaball-steps=1024,precision=double");
     EXPECT_TRUE(runs[2].isReference());
     EXPECT_EQ(runs[3].sameSamplingReference, "reference-spp1");
     EXPECT_EQ(runs[4].sameSamplingReference, "reference-spp4");
