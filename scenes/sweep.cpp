@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <set>
@@ -188,22 +189,20 @@ uint64_t sweepJobUnits(const SweepPlan& plan, const SweepRun& run) {
     return uint64_t(run.isReference() ? 1 : plan.repeats) * runSettings(plan, run).spp;
 }
 
-SweepTiming runSweepJob(const fs::path& dir, const std::string& id, Progress* progress) {
-    const SweepPlan plan = readSweepPlan(dir);
-    const std::vector<SweepRun> runs = planRuns(plan);
-    const SweepRun& run = findRun(runs, id, dir);
-    RenderSettings settings = runSettings(plan, run);
-    std::unique_ptr<Scene> scene = loadScene(plan.scene);
+namespace {
 
+// Renders `settings` `renders` times, timing each, and writes runs/<id>.exr and runs/<id>.json.
+SweepTiming renderRun(const fs::path& dir, Scene& scene, const SweepPlan& plan, const std::string& id,
+                      const std::string& settingsText, const RenderSettings& settings, uint64_t renders,
+                      Progress* progress) {
     SweepTiming timing;
     timing.id = id;
     timing.threads = plan.threads;
     timing.host = hostName();
-    const uint64_t renders = sweepJobUnits(plan, run) / settings.spp;
     RenderResult result;
-    for (uint32_t i = 0; i < renders; ++i) {
+    for (uint64_t i = 0; i < renders; ++i) {
         const auto start = std::chrono::steady_clock::now();
-        result = scene->render(settings);
+        result = scene.render(settings);
         timing.seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
         if (progress) progress->advance(settings.spp);
     }
@@ -215,15 +214,148 @@ SweepTiming runSweepJob(const fs::path& dir, const std::string& id, Progress* pr
     writeImage(runImagePath(dir, id).string(), result.image);
     json::Writer w;
     w.beginObject();
-    w.member("format", kRunFormat).member("id", id).member("settings", run.settings);
+    w.member("format", kRunFormat).member("id", id).member("settings", settingsText);
     w.key("seconds").beginArray(json::Writer::Layout::Inline);
-    for (double s : timing.seconds) w.value(s);
+    for (double sec : timing.seconds) w.value(sec);
     w.endArray();
     w.member("medianSeconds", timing.medianSeconds).member("threads", timing.threads).member("host", timing.host);
     w.member("warnings", timing.warnings);
     w.endObject();
     writeText(runJsonPath(dir, id), w.text() + "\n");
     return timing;
+}
+
+// Compares run images with reference runs, reading each reference once.
+class ReferenceImages {
+public:
+    explicit ReferenceImages(fs::path dir) : dir_(std::move(dir)) {}
+    SweepError errorOf(const std::string& referenceId, const Image& image) {
+        auto it = images_.find(referenceId);
+        if (it == images_.end()) it = images_.emplace(referenceId, readImage(runImagePath(dir_, referenceId).string())).first;
+        SweepError e{compareImages(it->second, image, CompareThresholds{}),
+                     compareImages(it->second, image, CompareThresholds::golden())};
+        e.idiff.diffImage = Image();  // the report keeps numbers only
+        e.golden.diffImage = Image();
+        return e;
+    }
+
+private:
+    fs::path dir_;
+    std::map<std::string, Image> images_;
+};
+
+bool passesGolden(const SweepError& e) { return e.golden.verdict <= CompareVerdict::Warn; }
+
+// The one-sample reference run of a plan (see planRuns).
+const SweepRun& oneSampleReference(const std::vector<SweepRun>& runs, const fs::path& dir) {
+    return findRun(runs, findRun(runs, "defaults", dir).sameSamplingReference, dir);
+}
+
+// The knobs the golden search relaxes, in order, with the values it tries for each.
+std::vector<std::pair<std::string, std::vector<std::string>>> goldenSearchCandidates(const SweepPlan& plan,
+                                                                                      const RenderSettings& start) {
+    std::vector<std::string> order = {"precision", "steps", "metaball-steps", "threshold"};
+    for (const KnobInfo& k : knobs())
+        if (std::find(order.begin(), order.end(), k.name) == order.end() && k.name != "spp") order.push_back(k.name);
+    const RenderSettings defaults;
+    std::vector<std::pair<std::string, std::vector<std::string>>> candidates;
+    for (const std::string& name : order) {
+        const std::string from = knobValue(start, name), to = knobValue(defaults, name);
+        if (from == to) continue;
+        std::vector<std::string> values = {to};
+        if (name != "precision") {
+            // The plan's swept values strictly between the default and the start, nearest the default first.
+            const double a = std::stod(to), b = std::stod(from);
+            std::vector<std::pair<double, std::string>> between;
+            for (const SweepKnob& k : plan.knobs)
+                if (k.name == name)
+                    for (const std::string& v : k.values) {
+                        RenderSettings s;
+                        applyKnob(s, name, v);
+                        const double x = std::stod(knobValue(s, name));
+                        if ((x - a) * (x - b) < 0.0) between.push_back({std::fabs(x - a), knobValue(s, name)});
+                    }
+            std::sort(between.begin(), between.end());
+            for (const auto& [distance, v] : between)
+                if (std::find(values.begin(), values.end(), v) == values.end()) values.push_back(v);
+        }
+        candidates.push_back({name, values});
+    }
+    return candidates;
+}
+
+constexpr const char* kGoldenSearchFormat = "refray-golden-search/1";
+
+}  // namespace
+
+SweepTiming runSweepJob(const fs::path& dir, const std::string& id, Progress* progress) {
+    const SweepPlan plan = readSweepPlan(dir);
+    const std::vector<SweepRun> runs = planRuns(plan);
+    const SweepRun& run = findRun(runs, id, dir);
+    const RenderSettings settings = runSettings(plan, run);
+    std::unique_ptr<Scene> scene = loadScene(plan.scene);
+    return renderRun(dir, *scene, plan, id, run.settings, settings, sweepJobUnits(plan, run) / settings.spp, progress);
+}
+
+uint64_t goldenSearchUnits(const SweepPlan& plan) {
+    const std::vector<SweepRun> runs = planRuns(plan);
+    RenderSettings start = runSettings(plan, runs.front());
+    start.spp = 1;
+    uint64_t tries = 1;
+    for (const auto& [knob, values] : goldenSearchCandidates(plan, start)) tries += values.size();
+    return tries * plan.repeats;
+}
+
+std::vector<GoldenSearchStep> runGoldenSearch(const fs::path& dir, Progress* progress) {
+    const SweepPlan plan = readSweepPlan(dir);
+    const std::vector<SweepRun> runs = planRuns(plan);
+    const SweepRun& reference = oneSampleReference(runs, dir);
+    REFRAY_CHECK(fs::exists(runImagePath(dir, reference.id)),
+                 "the golden search compares with the one-sample reference; run its job first (refray sweep --job "
+                     << reference.id << " -o " << dir.string() << ")");
+    std::unique_ptr<Scene> scene = loadScene(plan.scene);
+    ReferenceImages references(dir);
+
+    RenderSettings current = runSettings(plan, reference);
+    std::vector<GoldenSearchStep> steps;
+    auto tryRender = [&](const std::string& knob, const std::string& value, const RenderSettings& s) {
+        GoldenSearchStep step;
+        step.knob = knob;
+        step.value = value;
+        step.settings = describeKnobs(s);
+        const std::string id = "golden-" + std::to_string(steps.size());
+        step.timing = renderRun(dir, *scene, plan, id, step.settings, s, plan.repeats, progress);
+        step.error = references.errorOf(reference.id, readImage(runImagePath(dir, id).string()));
+        step.passes = passesGolden(step.error);
+        steps.push_back(step);
+        return step.passes;
+    };
+    tryRender("", "", current);  // the start, timed; passes by construction (it is the reference's image)
+    for (const auto& [knob, values] : goldenSearchCandidates(plan, current)) {
+        for (const std::string& value : values) {
+            RenderSettings candidate = current;
+            applyKnob(candidate, knob, value);
+            if (tryRender(knob, value, candidate)) {
+                current = candidate;
+                break;
+            }
+        }
+    }
+
+    json::Writer w;
+    w.beginObject();
+    w.member("format", kGoldenSearchFormat).member("reference", reference.id).member("result", describeKnobs(current));
+    w.key("steps").beginArray();
+    for (size_t i = 0; i < steps.size(); ++i)
+        w.beginObject(json::Writer::Layout::Inline)
+            .member("id", "golden-" + std::to_string(i))
+            .member("knob", steps[i].knob)
+            .member("value", steps[i].value)
+            .member("settings", steps[i].settings)
+            .endObject();
+    w.endArray().endObject();
+    writeText(dir / "golden-search.json", w.text() + "\n");
+    return steps;
 }
 
 std::vector<std::string> sweepJobCommands(const fs::path& dir, const std::string& executable) {
@@ -243,16 +375,7 @@ SweepReport collectSweep(const fs::path& dir) {
                      "the sweep in " << dir.string() << " has no " << required << " run yet ("
                                      << runJsonPath(dir, required).string() << "); run its job first");
     report.referenceTiming = readTiming(runJsonPath(dir, "reference"));
-    std::map<std::string, Image> references;
-    auto errorAgainst = [&](const std::string& referenceId, const Image& image) {
-        auto it = references.find(referenceId);
-        if (it == references.end()) it = references.emplace(referenceId, readImage(runImagePath(dir, referenceId).string())).first;
-        SweepError e{compareImages(it->second, image, CompareThresholds{}),
-                     compareImages(it->second, image, CompareThresholds::golden())};
-        e.idiff.diffImage = Image();  // the report keeps numbers only
-        e.golden.diffImage = Image();
-        return e;
-    };
+    ReferenceImages references(dir);
     std::set<std::string> missing;
     for (const SweepRun& run : runs)
         if (!fs::exists(runJsonPath(dir, run.id)) || !fs::exists(runImagePath(dir, run.id))) missing.insert(run.id);
@@ -263,9 +386,43 @@ SweepReport collectSweep(const fs::path& dir) {
         row.run = run;
         row.timing = readTiming(runJsonPath(dir, run.id));
         const Image image = readImage(runImagePath(dir, run.id).string());
-        row.total = errorAgainst("reference", image);
-        row.numerical = errorAgainst(run.sameSamplingReference, image);
+        row.total = references.errorOf("reference", image);
+        row.numerical = references.errorOf(run.sameSamplingReference, image);
         report.rows.push_back(std::move(row));
+    }
+
+    if (!missing.count("defaults") && !missing.count("precision=double") &&
+        std::any_of(runs.begin(), runs.end(), [](const SweepRun& r) { return r.id == "precision=double"; })) {
+        const Image doubleImage = readImage(runImagePath(dir, "precision=double").string());
+        const Image floatImage = readImage(runImagePath(dir, "defaults").string());
+        report.floatAgainstDouble = SweepError{compareImages(doubleImage, floatImage, CompareThresholds{}),
+                                               compareImages(doubleImage, floatImage, CompareThresholds::golden())};
+        report.floatAgainstDouble->idiff.diffImage = Image();
+        report.floatAgainstDouble->golden.diffImage = Image();
+    }
+
+    if (fs::exists(dir / "golden-search.json")) {
+        const json::Value root = json::parseFile(dir / "golden-search.json");
+        json::ObjectReader r(root, "the golden search");
+        const json::Value& format = r.required("format");
+        if (format.asString() != kGoldenSearchFormat) format.fail("expected format " + inQuotes(kGoldenSearchFormat));
+        const std::string referenceId = r.required("reference").asString();
+        report.goldenSearchResult = r.required("result").asString();
+        for (const json::Value& v : r.required("steps").asArray()) {
+            json::ObjectReader step(v, "a golden search step");
+            GoldenSearchStep g;
+            const std::string id = step.required("id").asString();
+            g.knob = step.required("knob").asString();
+            g.value = step.required("value").asString();
+            g.settings = step.required("settings").asString();
+            step.finish();
+            g.timing = readTiming(runJsonPath(dir, id));
+            g.error = references.errorOf(referenceId, readImage(runImagePath(dir, id).string()));
+            g.passes = passesGolden(g.error);
+            if (!report.goldenSearchStart) report.goldenSearchStart = g;
+            else report.goldenSearch.push_back(std::move(g));
+        }
+        r.finish();
     }
     markParetoFronts(report);
     report.goldenSettings = cheapestPassing(report);

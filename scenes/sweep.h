@@ -104,16 +104,46 @@ struct SweepRow {
     bool onGlobalFront = false;  // ... of (median time, numerical RMSE) among the rows with one sample per pixel
 };
 
+// One render of the golden search (runGoldenSearch).
+struct GoldenSearchStep {
+    std::string knob;      // the knob relaxed in this step
+    std::string value;     // the value tried
+    std::string settings;  // the whole setting rendered
+    SweepTiming timing;
+    SweepError error;  // against the one-sample reference
+    bool passes = false;  // --golden does not fail (PASS or WARNING); a passing value is kept
+};
+
 struct SweepReport {
     SweepPlan plan;
     SweepTiming referenceTiming;
     std::vector<SweepRow> rows;  // defaults first, then planRuns order (the reference is not a row)
     std::vector<std::string> missing;  // run ids with no result in runs/
+    // The defaults' render against the same settings in double precision, when "precision=double" was swept: how
+    // far float rounding alone moves the HLSL's image, i.e. what a GPU's own float arithmetic may move it too.
+    std::optional<SweepError> floatAgainstDouble;
     // The cheapest row (by median time) with one sample per pixel, as the GPU renders, that passes the --golden
     // profile against the one-sample reference; empty if none.
     std::optional<size_t> goldenSettings;
     std::vector<std::filesystem::path> plots;  // written PNGs, relative to the sweep directory
+    // The golden search, when one was run (golden-search.json): its start (the one-sample reference's settings,
+    // timed) and each step, in order.
+    std::optional<GoldenSearchStep> goldenSearchStart;
+    std::vector<GoldenSearchStep> goldenSearch;
+    // The settings the search ended with: the cheapest it found that pass.
+    std::string goldenSearchResult;
 };
+
+// A golden needs several knobs raised together, which a one-knob-at-a-time sweep cannot show. The search starts from
+// the reference's settings at one sample per pixel (which pass against the one-sample reference by construction)
+// and relaxes one knob at a time towards its default: precision, then steps, metaball-steps, threshold, then any
+// other. For each knob it tries the default, then the plan's swept values between the default and the reference's,
+// nearest the default first, and keeps the first value whose render still passes --golden. Each try is rendered and
+// timed like a run (runs/golden-<n>.exr / .json). Needs the one-sample reference run of the plan; writes
+// golden-search.json, which collectSweep reports. `progress` advances per render.
+std::vector<GoldenSearchStep> runGoldenSearch(const std::filesystem::path& dir, Progress* progress = nullptr);
+// The renders runGoldenSearch makes at most (for a progress bar): repeats per candidate value.
+uint64_t goldenSearchUnits(const SweepPlan& plan);
 
 // Compares every run in `dir` with the reference run and writes sweep.csv, sweep.md and plots/*.png. Throws
 // refray::Error when the reference run or the defaults run is missing (other missing runs are listed).

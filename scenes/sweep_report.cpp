@@ -175,7 +175,32 @@ std::string sweepMarkdown(const SweepReport& report) {
           "to 0.1 % of such pixels.\n\n";
 
     md << "## Golden settings\n\n";
-    if (report.goldenSettings) {
+    if (report.goldenSearchStart) {
+        const GoldenSearchStep& start = *report.goldenSearchStart;
+        const GoldenSearchStep* result = &start;
+        for (const GoldenSearchStep& g : report.goldenSearch)
+            if (g.passes) result = &g;
+        md << "A golden is compared with one GPU frame, so it is rendered with one sample per pixel. The golden search "
+              "(`--golden-search`) starts from the reference's settings at one sample per pixel and relaxes one knob "
+              "at a time towards its default, keeping each value whose render still passes `refray compare --golden` "
+              "against the one-sample reference:\n\n";
+        md << "| step | tried | setting | median s | x defaults | numerical RMSE | > 0.005 % | --golden | kept |\n";
+        md << "|---|---|---|---|---|---|---|---|---|\n";
+        auto stepRow = [&](size_t n, const GoldenSearchStep& g) {
+            md << "| " << n << " | " << (g.knob.empty() ? "start" : "`" + g.knob + "=" + g.value + "`") << " | `"
+               << g.settings << "` | " << fixed(g.timing.medianSeconds, 3) << " | "
+               << (base > 0 ? fixed(g.timing.medianSeconds / base, 2) : "") << " | " << general(g.error.idiff.rmse) << " | "
+               << general(g.error.golden.failingPercent(), 3) << " | " << verdictText(g.error.golden) << " | "
+               << (g.knob.empty() ? "" : g.passes ? "yes" : "no") << " |\n";
+        };
+        stepRow(0, start);
+        for (size_t i = 0; i < report.goldenSearch.size(); ++i) stepRow(i + 1, report.goldenSearch[i]);
+        md << "\n**Golden settings: `" << report.goldenSearchResult << "`**, " << fixed(result->timing.medianSeconds, 3)
+           << " s";
+        if (base > 0) md << " (" << fixed(result->timing.medianSeconds / base, 2) << "x the defaults' time)";
+        md << ". The search is greedy: it finds a cheap passing setting, not necessarily the cheapest of all "
+              "combinations.\n\n";
+    } else if (report.goldenSettings) {
         const SweepRow& g = report.rows[*report.goldenSettings];
         md << "A golden is compared with one GPU frame, so it is rendered with one sample per pixel. The cheapest such "
               "setting that passes `refray compare --golden` against the one-sample reference: **`"
@@ -195,6 +220,14 @@ std::string sweepMarkdown(const SweepReport& report) {
            << general(defaults->numerical.idiff.rmse) << " (" << general(defaults->numerical.golden.failingPercent(), 3)
            << " % of pixels over 0.005, `--golden` " << verdictText(defaults->numerical.golden) << "); total RMSE "
            << general(defaults->total.idiff.rmse) << ", PSNR " << fixed(defaults->total.idiff.psnr, 1) << " dB.\n\n";
+        if (report.floatAgainstDouble) {
+            const SweepError& e = *report.floatAgainstDouble;
+            md << "Float rounding alone (the defaults against the same settings in double): RMSE " << general(e.idiff.rmse)
+               << ", " << general(e.golden.failingPercent(), 3) << " % of pixels over 0.005, largest difference "
+               << general(e.idiff.maxError.value, 3) << ", `--golden` " << verdictText(e.golden)
+               << ". A GPU's float arithmetic differs from refray's in the same way (other transcendentals, other "
+                  "operation order), so expect a GPU render to differ from a golden by about this much.\n\n";
+        }
         std::vector<const SweepRow*> dominating;
         const double error = defaults->numerical.idiff.rmse;
         for (size_t i : oneSampleRows(report)) {

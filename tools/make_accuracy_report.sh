@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs the accuracy sweeps of both reference scenes on this machine and writes docs/accuracy-vs-time.md with their
-# plots (docs/images/accuracy/). Needs a release build (bash tools/refray.sh builds one). Takes about 10 minutes on
+# plots (docs/images/accuracy/). Needs a release build (bash tools/refray.sh builds one). Takes about 6 minutes on
 # 2 cores. Usage: bash tools/make_accuracy_report.sh [THREADS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,7 +13,7 @@ doc=docs/accuracy-vs-time.md
 rm -rf "$work" "$images"
 mkdir -p "$work" "$images"
 
-common=(--size 320x180 --repeats 3 --threads "$threads"
+common=(--size 320x180 --repeats 5 --threads "$threads" --golden-search
         --knob steps=0.125,0.25,0.5,2,4 --knob threshold=0.25,0.5,2,4,8 --knob normal-epsilon=0.1,0.5,2,10
         --knob recursion-depth=1,2,4,6 --knob precision=double --knob spp=4,9,16)
 

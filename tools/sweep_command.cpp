@@ -66,7 +66,9 @@ void printSummary(const scenes::SweepReport& report, const fs::path& dir) {
                     base > 0 ? r.timing.medianSeconds / base : 0.0, r.numerical.idiff.rmse,
                     r.numerical.golden.failingPercent(), std::string(toString(r.numerical.golden.verdict)).c_str(),
                     r.total.idiff.rmse, r.onGlobalFront ? "  (front)" : "");
-    if (report.goldenSettings)
+    if (!report.goldenSearchResult.empty())
+        std::printf("golden settings (golden search): %s\n", report.goldenSearchResult.c_str());
+    else if (report.goldenSettings)
         std::printf("golden settings (cheapest one-sample setting passing --golden): %s\n",
                     report.rows[*report.goldenSettings].run.settings.c_str());
     else
@@ -74,6 +76,18 @@ void printSummary(const scenes::SweepReport& report, const fs::path& dir) {
     if (!report.missing.empty()) std::printf("missing runs: %s\n", joined(report.missing).c_str());
     std::printf("wrote %s, %s and %zu plots in %s\n", (dir / "sweep.md").string().c_str(),
                 (dir / "sweep.csv").string().c_str(), report.plots.size(), (dir / "plots").string().c_str());
+}
+
+void goldenSearch(const std::string& dir) {
+    Progress progress("golden search", scenes::goldenSearchUnits(scenes::readSweepPlan(dir)), terminalProgress(),
+                      std::chrono::milliseconds(250));
+    const std::vector<scenes::GoldenSearchStep> steps = scenes::runGoldenSearch(dir, &progress);
+    progress.finish();
+    for (const scenes::GoldenSearchStep& s : steps)
+        std::printf("golden search: %-22s %-36s %8.3f s  %-8s %s\n",
+                    s.knob.empty() ? "start" : (s.knob + "=" + s.value).c_str(), s.settings.c_str(),
+                    s.timing.medianSeconds, std::string(toString(s.error.golden.verdict)).c_str(),
+                    s.knob.empty() ? "" : (s.passes ? "kept" : "rejected"));
 }
 
 }  // namespace
@@ -95,6 +109,9 @@ CLI::App* addSweepCommand(CLI::App& app, SweepCommandOptions& o) {
     sweep->add_option("--emit-jobs", o.emitJobs, "Plan only: write one command line per setting to this file");
     sweep->add_option("--collect", o.collect, "Report only: merge the runs in this sweep directory");
     sweep->add_option("--job", o.job, "Render one setting (a run id of the plan in --output); what --emit-jobs writes");
+    sweep->add_flag("--golden-search", o.goldenSearch,
+                    "Also search for the cheapest one-sample settings that pass --golden: relax the reference's knobs "
+                    "one at a time towards their defaults (sequential; with --collect, after merging)");
     char footer[4096];
     std::snprintf(footer, sizeof footer, kFooter, knobList().c_str());
     sweep->footer(footer);
@@ -104,9 +121,12 @@ CLI::App* addSweepCommand(CLI::App& app, SweepCommandOptions& o) {
 int runSweep(const SweepCommandOptions& o) {
     REFRAY_CHECK(int(!o.collect.empty()) + int(!o.job.empty()) + int(!o.emitJobs.empty()) <= 1,
                  "--collect, --job and --emit-jobs are separate steps; give one of them");
+    REFRAY_CHECK(!o.goldenSearch || (o.job.empty() && o.emitJobs.empty()),
+                 "--golden-search renders one setting after another; give it to the sweep itself or to --collect");
     if (!o.collect.empty()) {
         REFRAY_CHECK(o.scene.empty() && o.knobs.empty(), "--collect reads the plan in " << o.collect
                                                                                           << "; give no scene or knobs");
+        if (o.goldenSearch) goldenSearch(o.collect);
         printSummary(scenes::collectSweep(o.collect), o.collect);
         return 0;
     }
@@ -152,6 +172,7 @@ int runSweep(const SweepCommandOptions& o) {
     Progress progress("sweep", units, terminalProgress(), std::chrono::milliseconds(250));
     for (const scenes::SweepRun& r : runs) scenes::runSweepJob(o.output, r.id, &progress);
     progress.finish();
+    if (o.goldenSearch) goldenSearch(o.output);
     printSummary(scenes::collectSweep(o.output), o.output);
     return 0;
 }

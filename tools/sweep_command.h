@@ -31,6 +31,7 @@ struct SweepCommandOptions {
     std::string emitJobs;  // a file: plan only, write the job lines there
     std::string collect;   // a sweep directory: report only
     std::string job;       // a run id: render that one setting of the plan in --output
+    bool goldenSearch = false;  // after the runs (or with --collect), search for the cheapest passing settings
 };
 
 // Adds the `sweep` subcommand to `app`; app.parse() fills `options`, which must outlive the parse.

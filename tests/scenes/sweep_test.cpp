@@ -181,6 +181,49 @@ TEST(Sweep, JobsAndCollectWriteTheReport) {
     EXPECT_NE(errorOf([&] { collectSweep(dir); }).find("has no reference run yet"), std::string::npos);
 }
 
+// The golden search starts at the reference's settings with one sample (identical to the one-sample reference), tries
+// precision first, then steps at the default and at the swept value between default and reference, and keeps a value
+// exactly when its render passes --golden.
+TEST(Sweep, GoldenSearchRelaxesOneKnobAtATime) {
+    const fs::path dir = freshDirectory("sweep-golden-search");
+    SweepPlan plan = smallPlan();
+    plan.repeats = 1;
+    plan.reference = "precision=double,steps=2,spp=4";
+    plan.knobs = {{"steps", {"1.5", "3"}}, {"precision", {"double"}}};
+    writeSweepPlan(dir, plan);
+    for (const SweepRun& r : planRuns(readSweepPlan(dir))) runSweepJob(dir, r.id);
+    EXPECT_EQ(goldenSearchUnits(readSweepPlan(dir)), 4u);  // start, precision=float, steps=1, steps=1.5
+
+    const std::vector<GoldenSearchStep> steps = runGoldenSearch(dir);
+    ASSERT_GE(steps.size(), 3u);
+    EXPECT_EQ(steps[0].settings, "steps=2,precision=double");
+    EXPECT_EQ(steps[0].error.idiff.rmse, 0.0);  // the one-sample reference's own settings
+    EXPECT_EQ(steps[1].knob, "precision");
+    EXPECT_EQ(steps[1].value, "float");
+    EXPECT_EQ(steps[2].knob, "steps");
+    EXPECT_EQ(steps[2].value, "1");
+    if (steps.size() == 4) {
+        EXPECT_FALSE(steps[2].passes);
+        EXPECT_EQ(steps[3].value, "1.5");
+    }
+    RenderSettings expected;
+    applyKnobList(expected, "steps=2,precision=double");
+    for (size_t i = 1; i < steps.size(); ++i) {
+        EXPECT_EQ(steps[i].passes, steps[i].error.golden.verdict <= CompareVerdict::Warn) << i;
+        if (steps[i].passes) applyKnob(expected, steps[i].knob, steps[i].value);
+    }
+
+    const SweepReport report = collectSweep(dir);
+    ASSERT_TRUE(report.goldenSearchStart);
+    EXPECT_EQ(report.goldenSearch.size(), steps.size() - 1);
+    EXPECT_EQ(report.goldenSearchResult, describeKnobs(expected));
+    ASSERT_TRUE(report.floatAgainstDouble);
+    EXPECT_GT(report.floatAgainstDouble->idiff.rmse, 0.0);
+    const std::string md = readText((dir / "sweep.md").string());
+    EXPECT_NE(md.find("**Golden settings: `" + report.goldenSearchResult + "`**"), std::string::npos) << md;
+    EXPECT_NE(md.find("Float rounding alone"), std::string::npos);
+}
+
 TEST(Sweep, JobCommandsNameEveryRunAndErrorsNameTheDirectory) {
     const fs::path dir = freshDirectory("sweep-jobs");
     writeSweepPlan(dir, smallPlan());
