@@ -74,14 +74,21 @@ const SweepRun& findRun(const std::vector<SweepRun>& runs, const std::string& id
                 "; its runs: " + joined(ids));
 }
 
+// Parses a file of the sweep and checks its "format" member (which `reader` then counts as read).
+json::Value parseSweepFile(const fs::path& path, const char* format) {
+    json::Value root = json::parseFile(path);
+    if (const json::Value* f = root.isObject() ? root.find("format") : nullptr; f && f->isString() && f->asString() != format)
+        f->fail("expected format " + inQuotes(format));
+    return root;
+}
+
 fs::path runImagePath(const fs::path& dir, const std::string& id) { return dir / "runs" / (id + ".exr"); }
 fs::path runJsonPath(const fs::path& dir, const std::string& id) { return dir / "runs" / (id + ".json"); }
 
 SweepTiming readTiming(const fs::path& path) {
-    const json::Value root = json::parseFile(path);
+    const json::Value root = parseSweepFile(path, kRunFormat);
     json::ObjectReader r(root, "a sweep run");
-    const json::Value& format = r.required("format");
-    if (format.asString() != kRunFormat) format.fail("expected format " + inQuotes(kRunFormat));
+    r.required("format").asString();
     SweepTiming t;
     t.id = r.required("id").asString();
     r.required("settings");
@@ -160,10 +167,9 @@ SweepPlan readSweepPlan(const fs::path& dir) {
     REFRAY_CHECK(fs::exists(path), dir.string() << " holds no sweep (no plan.json); write one with 'refray sweep SCENE "
                                                    "--knob ... --emit-jobs FILE -o "
                                                 << dir.string() << "'");
-    const json::Value root = json::parseFile(path);
+    const json::Value root = parseSweepFile(path, kPlanFormat);
     json::ObjectReader r(root, "the sweep plan");
-    const json::Value& format = r.required("format");
-    if (format.asString() != kPlanFormat) format.fail("expected format " + inQuotes(kPlanFormat));
+    r.required("format").asString();
     SweepPlan plan;
     plan.scene = r.required("scene").asString();
     plan.camera = r.required("camera").asString();
@@ -402,10 +408,9 @@ SweepReport collectSweep(const fs::path& dir) {
     }
 
     if (fs::exists(dir / "golden-search.json")) {
-        const json::Value root = json::parseFile(dir / "golden-search.json");
+        const json::Value root = parseSweepFile(dir / "golden-search.json", kGoldenSearchFormat);
         json::ObjectReader r(root, "the golden search");
-        const json::Value& format = r.required("format");
-        if (format.asString() != kGoldenSearchFormat) format.fail("expected format " + inQuotes(kGoldenSearchFormat));
+        r.required("format").asString();
         const std::string referenceId = r.required("reference").asString();
         report.goldenSearchResult = r.required("result").asString();
         for (const json::Value& v : r.required("steps").asArray()) {
