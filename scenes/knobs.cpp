@@ -53,14 +53,15 @@ std::string factorText(double x) {
     return std::string(text, end.ptr);
 }
 
-// An optional Accuracy count whose unset value means `hlslDefault`.
+// An optional Accuracy count whose unset value means `hlslDefault`. With `keepExplicit`, a value equal to the
+// default is kept as set (it overrides what a scene file's effects block says, e.g. reflectionDepth 1).
 KnobAccess countKnob(KnobInfo info, std::optional<uint32_t> procedural::Accuracy::*field, uint32_t hlslDefault,
-                     uint32_t lo, uint32_t hi) {
+                     uint32_t lo, uint32_t hi, bool keepExplicit = false) {
     const std::string name = info.name;
     return {std::move(info),
             [=](RenderSettings& s, std::string_view v) {
                 const uint32_t n = parseCount(name, v, lo, hi);
-                s.accuracy.*field = n == hlslDefault ? std::nullopt : std::optional<uint32_t>(n);
+                s.accuracy.*field = n == hlslDefault && !keepExplicit ? std::nullopt : std::optional<uint32_t>(n);
             },
             [=](const RenderSettings& s) { return std::to_string((s.accuracy.*field).value_or(hlslDefault)); },
             [=](const RenderSettings& s) { return !(s.accuracy.*field).has_value(); }};
@@ -93,7 +94,7 @@ const std::vector<KnobAccess>& knobAccess() {
         k.push_back(countKnob({"metaball-steps", "samples of the metaballs' fixed-step march (HLSL: 128)", "count", true},
                               &Accuracy::metaballSteps, kDefaultMetaballSteps, 1, 65536));
         k.push_back(countKnob({"recursion-depth", "MAX_RAY_RECURSION_DEPTH: reflection bounces (HLSL: 3)", "count", true},
-                              &Accuracy::maxRecursionDepth, kDefaultRecursionDepth, 1, 31));
+                              &Accuracy::maxRecursionDepth, kDefaultRecursionDepth, 1, 31, /*keepExplicit*/ true));
         k.push_back({{"spp", "samples per pixel, a square number (k x k pixel centres)", "count", true},
                      [](RenderSettings& s, std::string_view v) {
                          const uint32_t n = parseCount("spp", v, 1, 4096);

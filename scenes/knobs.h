@@ -23,7 +23,8 @@ const std::vector<KnobInfo>& knobs();
 
 // Sets knob `name` to `value` (its text). Throws refray::Error naming the knob and the accepted values for an
 // unknown name (with a did-you-mean) or a value out of range. Setting a knob to the HLSL's value stores the default,
-// so equal settings compare equal whichever way they were written.
+// so equal settings compare equal whichever way they were written; except recursion-depth, which is kept as given
+// because it also overrides a scene file's "effects": {"reflectionDepth"}.
 void applyKnob(RenderSettings& settings, std::string_view name, std::string_view value);
 // "name=value" (one --knob argument).
 void applyKnobAssignment(RenderSettings& settings, std::string_view assignment);

@@ -7,6 +7,7 @@
 
 #include "core/error.h"
 #include "core/strings.h"
+#include "scenes/effects.h"
 #include "scenes/knobs.h"
 #include "scenes/scene_loader.h"
 
@@ -146,7 +147,10 @@ Scene::Pipeline& Scene::pipelineFor(const LibraryOptions& options) {
     std::vector<procedural::TraceRayArguments> traceRay;  // what the shaders pass, per ray type
     for (const RayTypeDesc& t : desc_.rayTypes)
         traceRay.push_back({t.rayContribution, t.multiplier, t.missShaderIndex, t.instanceInclusionMask});
-    so.libraries = {{binding.make(options.precision, traceRay, options.accuracy), {}}};
+    // The render's knobs with the scene's effects block: its reflectionDepth (unless a knob sets the depth) and the
+    // call sites it switches off.
+    const procedural::Accuracy accuracy = libraryAccuracy(desc_, options.accuracy);
+    so.libraries = {{binding.make(options.precision, traceRay, accuracy, libraryEffects(desc_)), {}}};
     so.hitGroups = desc_.hitGroups;
     for (size_t i = 0; i < localSignatures_.size(); ++i)
         if (!desc_.localAssociations[i].empty())
@@ -155,8 +159,7 @@ Scene::Pipeline& Scene::pipelineFor(const LibraryOptions& options) {
     so.shaderConfigs = {{desc_.maxPayloadBytes, desc_.maxAttributeBytes}};
     // PORT: a recursion-depth knob is the shaders and the host recompiled with another MAX_RAY_RECURSION_DEPTH, so
     // the pipeline allows at least that depth.
-    so.pipelineConfigs = {{std::max(desc_.maxRecursionDepth, options.accuracy.maxRecursionDepth.value_or(0)),
-                           PIPELINE_FLAG_NONE}};
+    so.pipelineConfigs = {{pipelineRecursionDepth(desc_, accuracy), PIPELINE_FLAG_NONE}};
     Pipeline p;
     p.stateObject = StateObject::create(so);
 
@@ -317,6 +320,7 @@ RenderResult Scene::render(const RenderSettings& settings) {
     meta["precision"] = std::string(procedural::toString(settings.precision));
     meta["spp"] = std::to_string(settings.spp);
     meta["knobs"] = describeKnobs(settings);
+    if (desc_.effects.present) meta["effects"] = describeEffectsBlock(desc_.effects);
     meta["size"] = std::to_string(settings.width) + "x" + std::to_string(settings.height);
     meta["traversal_order"] = settings.order == TraversalOrder::Ordered
                                   ? "ordered"

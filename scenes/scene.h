@@ -24,7 +24,8 @@ public:
     dxr::GpuVirtualAddress tlas() const { return tlas_; }
     // The GPU address of BLAS `index` (SceneDesc::blases order).
     dxr::GpuVirtualAddress blasAddress(size_t index) const { return blasAddresses_.at(index); }
-    // The state object and tables of `precision` and `accuracy` (built on first use).
+    // The state object and tables of `precision` and `accuracy` (the render's knobs; the scene's effects block is
+    // applied on top, scenes/effects.h), built on first use.
     const dxr::StateObjectPtr& pipeline(procedural::Precision precision, const procedural::Accuracy& accuracy = {}) {
         return pipelineFor({precision, accuracy}).stateObject;
     }

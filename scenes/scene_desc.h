@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -149,6 +150,18 @@ struct LessonDesc {
     std::string expectRender;
 };
 
+// The scene's "effects" block: effects of the shaders the scene switches off (docs/scene-format.md, scenes/effects.h).
+// The defaults are the shaders as written.
+struct EffectsDesc {
+    bool present = false;  // the file has an "effects" block
+    // false: the closest hits' shadow call sites return "not in shadow" without tracing (procedural::Effects).
+    bool shadows = true;
+    // The shaders' MAX_RAY_RECURSION_DEPTH (1..31; procedural::Accuracy::maxRecursionDepth), unless the render's
+    // recursion-depth knob sets it. Unset: the HLSL's.
+    std::optional<uint32_t> reflectionDepth;
+    json::Location where;
+};
+
 struct SceneDesc {
     std::filesystem::path file;
     std::string fileHash;  // SHA-256 of the file's bytes (a lesson: of its bytes and its bases')
@@ -192,6 +205,7 @@ struct SceneDesc {
     std::string defaultTimeText = "0";
     std::vector<float> canonicalTimes;
     uint32_t defaultWidth = 1280, defaultHeight = 720;
+    EffectsDesc effects;
 
     const CameraDesc& camera(const std::string& name) const;  // "" = the default; error lists the cameras
     int32_t findBuffer(const std::string& name) const;

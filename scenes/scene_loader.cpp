@@ -163,7 +163,7 @@ public:
             libraryValue.fail(e.what());
         }
         scene_.shaderLibrary = binding_->name;
-        library_ = binding_->make(procedural::Precision::Float, binding_->traceRayDefaults, {});
+        library_ = binding_->make(procedural::Precision::Float, binding_->traceRayDefaults, {}, {});
 
         if (const Value* v = top.optional("layout")) {
             const uint32_t mode = resolveName(*v, {"auto", "explicit"}, "layout");
@@ -194,6 +194,7 @@ public:
         parseCameras(top.required("cameras"), top.optional("defaultCamera"));
         parseLight(top.required("light"));
         if (const Value* v = top.optional("time")) parseTime(*v);
+        if (const Value* v = top.optional("effects")) parseEffects(*v);
         if (const Value* v = top.optional("imageSize")) {
             const auto& a = v->asArray();
             if (a.size() != 2) v->fail("imageSize needs [width, height]");
@@ -1113,6 +1114,26 @@ private:
                 scene_.canonicalTimes.push_back(t.asFloat());
                 if (scene_.canonicalTimes.back() < 0.0f) t.fail("time must not be negative");
             }
+        r.finish();
+    }
+
+    void parseEffects(const Value& value) {
+        ObjectReader r(value, "effects");
+        scene_.effects.present = true;
+        scene_.effects.where = value.location();
+        if (const Value* v = r.optional("shadows")) {
+            if (!v->isBool()) v->fail("'shadows' in effects is true or false, got " + std::string(v->kindName()));
+            scene_.effects.shadows = v->asBool();
+        }
+        if (const Value* v = r.optional("reflectionDepth")) {
+            if (!v->isNumber())
+                v->fail("'reflectionDepth' in effects is an integer 1..31, got " + std::string(v->kindName()));
+            const uint32_t depth = v->asUint32();
+            if (depth < 1 || depth > 31)
+                v->fail("reflectionDepth is the shaders' MAX_RAY_RECURSION_DEPTH, 1..31 (1: camera rays only), got " +
+                        std::to_string(depth));
+            scene_.effects.reflectionDepth = depth;
+        }
         r.finish();
     }
 

@@ -60,6 +60,54 @@ std::vector<uint8_t> d3d12Constants(const SceneConstantsInput& in) {
     return bytesOf(cb);
 }
 
+template <size_t N>
+std::vector<uint32_t> rayFlags(const std::array<uint32_t, N>& perRayType) {
+    return {perRayType.begin(), perRayType.end()};
+}
+
+// reference-scene-d3d12-procedural.md §1.7 (ray types), §2.5 (metaballs), §2.9-2.11 (closest hits).
+ShaderLibraryFacts d3d12Facts() {
+    namespace d = procedural::d3d12;
+    using E = ShaderEffect;
+    ShaderLibraryFacts f;
+    f.maxRayRecursionDepth = d::MAX_RAY_RECURSION_DEPTH;
+    f.shadowRayType = d::RayType::Shadow;
+    f.rayFlags = rayFlags(d::kTraceRayFlags);
+    f.uses = {
+        {E::ShadowRays, "MyClosestHitShader_Triangle", "", "", 0.0f},
+        {E::ShadowRays, "MyClosestHitShader_AABB", "", "", 0.0f},
+        {E::Reflections, "MyClosestHitShader_Triangle", "", "reflectanceCoef", 0.001f},
+        {E::Reflections, "MyClosestHitShader_AABB", "", "reflectanceCoef", 0.001f},
+        {E::Animation, "MyIntersectionShader_VolumetricPrimitive", "the metaballs' centres", "", 0.0f},
+        {E::DistanceFog, "MyClosestHitShader_Triangle", "", "", 0.0f},
+        {E::DistanceFog, "MyClosestHitShader_AABB", "", "", 0.0f},
+        {E::RayDifferentials, "MyClosestHitShader_Triangle", "the grid lines", "", 0.0f},
+    };
+    return f;
+}
+
+// reference-scene-proceduray.md §1.4 (ray types), §1.9 (time), §3 (closest hits: the Julia and the Mandelbulb trace
+// no shadow ray; the Julia always reflects with 0.1).
+ShaderLibraryFacts procedurayFacts() {
+    namespace p = procedural::proceduray;
+    using E = ShaderEffect;
+    ShaderLibraryFacts f;
+    f.maxRayRecursionDepth = p::MAX_RAY_RECURSION_DEPTH;
+    f.shadowRayType = p::Shadow;
+    f.rayFlags = rayFlags(p::kTraceRayFlags);
+    f.uses = {
+        {E::ShadowRays, "ClosestHit_Triangle", "", "", 0.0f},
+        {E::ShadowRays, "ClosestHit_Pacman", "", "", 0.0f},
+        {E::Reflections, "ClosestHit_Triangle", "", "reflectanceCoef", 0.001f},
+        {E::Reflections, "ClosestHit_Pacman", "", "reflectanceCoef", 0.001f},
+        {E::Reflections, "ClosestHit_Mandelbulb", "", "reflectanceCoef", 0.001f},
+        {E::Reflections, "ClosestHit_Julia", "", "", 0.0f},
+        {E::Animation, "Intersection_Mandelbulb", "the Mandelbulb's step count", "", 0.0f},
+        {E::Animation, "Intersection_Pacman", "the Pac-man's mouth", "", 0.0f},
+    };
+    return f;
+}
+
 }  // namespace
 
 const std::vector<ShaderLibraryBinding>& shaderLibraries() {
@@ -67,19 +115,20 @@ const std::vector<ShaderLibraryBinding>& shaderLibraries() {
         {"d3d12-procedural-geometry",
          "Microsoft D3D12RaytracingProceduralGeometry Raytracing.hlsl (procedural/d3d12/)",
          [](procedural::Precision p, const std::vector<procedural::TraceRayArguments>& traceRay,
-            const procedural::Accuracy& accuracy) {
+            const procedural::Accuracy& accuracy, const procedural::Effects& effects) {
              return procedural::d3d12::makeD3D12ShaderLibrary(p, argumentSet(traceRay, "d3d12-procedural-geometry"),
-                                                              accuracy);
+                                                              accuracy, effects);
          },
          d3d12Constants, false, procedural::d3d12::RayType::Count,
-         perRayType(procedural::d3d12::defaultTraceRayArguments().rayTypes)},
+         perRayType(procedural::d3d12::defaultTraceRayArguments().rayTypes), d3d12Facts()},
         {"proceduray", "Proceduray MandelJuliaPac Raytracing.hlsl (procedural/proceduray/)",
          [](procedural::Precision p, const std::vector<procedural::TraceRayArguments>& traceRay,
-            const procedural::Accuracy& accuracy) {
-             return procedural::proceduray::makeProcedurayShaderLibrary(p, argumentSet(traceRay, "proceduray"), accuracy);
+            const procedural::Accuracy& accuracy, const procedural::Effects& effects) {
+             return procedural::proceduray::makeProcedurayShaderLibrary(p, argumentSet(traceRay, "proceduray"), accuracy,
+                                                                        effects);
          },
          procedurayConstants, true, procedural::proceduray::RayTypeCount,
-         perRayType(procedural::proceduray::defaultTraceRayArguments().rayTypes)},
+         perRayType(procedural::proceduray::defaultTraceRayArguments().rayTypes), procedurayFacts()},
     };
     return libraries;
 }

@@ -11,6 +11,7 @@
 #include "core/math.h"
 #include "emulator/state_object.h"
 #include "procedural/accuracy.h"
+#include "procedural/effects.h"
 #include "procedural/precision.h"
 #include "procedural/sample_layout.h"
 #include "procedural/trace_ray_parameters.h"
@@ -32,13 +33,41 @@ struct SceneConstantsInput {
     int32_t debugFlag = 0;
 };
 
+// What a library's shaders do that the scene's DXR objects do not show, from its fact sheet: the exports that trace
+// shadow or reflection rays, read the time, or shade with an effect of their own. scenes/effects.h decides from these
+// (and from the scene) which effects a scene calls for.
+enum class ShaderEffect {
+    ShadowRays,        // traces the shadow ray type towards the light
+    Reflections,       // traces a reflection (radiance) ray
+    Animation,         // reads elapsedTime
+    DistanceFog,       // blends towards the background with the hit distance
+    RayDifferentials,  // filters a texture over the footprint of the neighbouring pixels' camera rays
+};
+struct ShaderEffectUse {
+    ShaderEffect effect;
+    std::string exportName;  // the export that does it
+    std::string what;        // a few words for the effect's reason, e.g. "the mouth"
+    // A material field that gates it per record (e.g. reflections only where "reflectanceCoef" > 0.001); empty:
+    // always. Read from a record's root constants when their struct has a field of this name.
+    std::string gateField;
+    float gateAbove = 0.0f;
+};
+struct ShaderLibraryFacts {
+    uint32_t maxRayRecursionDepth = 0;  // the HLSL's MAX_RAY_RECURSION_DEPTH
+    uint32_t shadowRayType = 0;         // the ray type TraceShadowRayAndReportIfHit traces
+    std::vector<uint32_t> rayFlags;     // per ray type, the RAY_FLAGs its TraceRay call passes
+    std::vector<ShaderEffectUse> uses;
+};
+
 struct ShaderLibraryBinding {
     std::string name;         // what scene files write in "shaderLibrary"
     std::string description;  // which HLSL it ports
     // Makes the library with its shaders' TraceRay arguments, one entry per ray type (exactly rayTypeCount; other
-    // counts throw refray::Error), and its accuracy knobs. `traceRayDefaults` gives the library's own.
-    std::function<std::shared_ptr<dxr::ShaderLibrary>(
-        procedural::Precision, const std::vector<procedural::TraceRayArguments>&, const procedural::Accuracy&)>
+    // counts throw refray::Error), its accuracy knobs and the effects switched off. `traceRayDefaults` gives the
+    // library's own TraceRay arguments; Accuracy{} and Effects{} give the HLSL's.
+    std::function<std::shared_ptr<dxr::ShaderLibrary>(procedural::Precision,
+                                                      const std::vector<procedural::TraceRayArguments>&,
+                                                      const procedural::Accuracy&, const procedural::Effects&)>
         make;
     // The bytes of the library's SceneConstantBuffer (its C++ struct, padding zeroed).
     std::function<std::vector<uint8_t>(const SceneConstantsInput&)> sceneConstants;
@@ -48,6 +77,8 @@ struct ShaderLibraryBinding {
     // What the HLSL passes to TraceRay for ray type r: RayContributionToHitGroupIndex r, multiplier rayTypeCount,
     // miss index r and its instance inclusion mask (~0 for both libraries), rayTypeCount entries.
     std::vector<procedural::TraceRayArguments> traceRayDefaults;
+    // What the shaders do besides (for scenes/effects.h).
+    ShaderLibraryFacts facts;
 };
 
 // The registered libraries, in name order.

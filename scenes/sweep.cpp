@@ -119,8 +119,9 @@ std::vector<SweepRun> planRuns(const SweepPlan& plan) {
         for (const std::string& v : k.values) {
             RenderSettings s = baseSettings(plan);
             applyKnob(s, k.name, v);
+            if (knobValue(s, k.name) == knobValue(RenderSettings{}, k.name)) continue;  // the defaults row
             const std::string settings = describeKnobs(s);
-            if (!seen.insert(settings).second) continue;  // the default value, or a repeat
+            if (!seen.insert(settings).second) continue;  // a repeat
             rows.push_back({settings, k.name, knobValue(s, k.name), settings, sameSampling(s.spp)});
             samplings.insert(s.spp);
         }

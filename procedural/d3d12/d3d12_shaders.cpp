@@ -181,16 +181,6 @@ REFRAY_INSTANTIATE_HELPERS(double)
 // ---- Accuracy knobs --------------------------------------------------------------------------------
 
 template <typename T>
-math::SphereTraceParams<T> sphereTraceParams(const Accuracy& accuracy, T stepScale) {
-    math::SphereTraceParams<T> params;  // the HLSL's constants
-    params.threshold = scaledConstant(params.threshold, accuracy.thresholdFactor);
-    params.maxSteps = scaledSteps(params.maxSteps, accuracy.stepsFactor);
-    params.stepScale = stepScale;
-    params.normalOffset = scaledConstant(params.normalOffset, accuracy.normalEpsilonFactor);
-    return params;
-}
-
-template <typename T>
 math::MetaballsParams<T> metaballsParams(const Accuracy& accuracy) {
     math::MetaballsParams<T> params;  // the HLSL's constants
     if (accuracy.metaballSteps) params.maxSteps = *accuracy.metaballSteps;
@@ -203,7 +193,6 @@ uint32_t maxRayRecursionDepth(const Accuracy& accuracy) {
 }
 
 #define REFRAY_INSTANTIATE_KNOBS(T)                                                                     \
-    template math::SphereTraceParams<T> sphereTraceParams<T>(const Accuracy&, T);                       \
     template math::MetaballsParams<T> metaballsParams<T>(const Accuracy&);
 REFRAY_INSTANTIATE_KNOBS(float)
 REFRAY_INSTANTIATE_KNOBS(double)
@@ -273,7 +262,8 @@ math::RayExtent<T> CurrentExtent(const ShaderContext& ctx) {
 // TraceRayParameters::HitGroup::GeometryStride and TraceRayParameters::MissShader::Offset[rayType]; here they come
 // from `traceRay` (the library's TraceRayArgumentSet, those same values by default), which every caller passes down.
 // PORT: MAX_RAY_RECURSION_DEPTH is the library's `maxDepth` (maxRayRecursionDepth of its Accuracy), passed down
-// the same way.
+// the same way; so is the library's Effects, whose traceShadowRays false makes every shadow call site return "not in
+// shadow" untraced, as at that depth.
 template <typename T>
 tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
                           const tvec3<T>& origin, const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
@@ -281,7 +271,7 @@ tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRa
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     RayPayload rayPayload{vec4(0.0f), currentRayRecursionDepth + 1};
     const TraceRayArguments& radiance = traceRay[RayType::Radiance];
-    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_CULL_BACK_FACING_TRIANGLES,
+    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[RayType::Radiance],
                  radiance.instanceInclusionMask, /*HitGroup::Offset*/ radiance.rayContribution,
                  /*HitGroup::GeometryStride*/ radiance.multiplier, /*MissShader::Offset*/ radiance.missShaderIndex,
                  rayDesc, rayPayload);
@@ -290,17 +280,16 @@ tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRa
 
 template <typename T>
 bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
-                                  const tvec3<T>& origin, const tvec3<T>& direction,
+                                  const Effects& effects, const tvec3<T>& origin, const tvec3<T>& direction,
                                   uint32_t currentRayRecursionDepth) {
     if (currentRayRecursionDepth >= maxDepth) return false;
+    if (!effects.traceShadowRays) return false;  // PORT: shadows switched off (procedural/effects.h)
     // TMax 10000, not the distance to the light (I2).
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     // Starts as "hit": closest-hit and any-hit shaders are skipped, only MyMissShader_ShadowRay clears it.
     ShadowRayPayload shadowPayload{1};
     const TraceRayArguments& shadow = traceRay[RayType::Shadow];
-    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure),
-                 RAY_FLAG_CULL_BACK_FACING_TRIANGLES | RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_FORCE_OPAQUE |
-                     RAY_FLAG_SKIP_CLOSEST_HIT_SHADER,
+    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[RayType::Shadow],
                  shadow.instanceInclusionMask, /*HitGroup::Offset*/ shadow.rayContribution,
                  /*HitGroup::GeometryStride*/ shadow.multiplier, /*MissShader::Offset*/ shadow.missShaderIndex, rayDesc,
                  shadowPayload);
@@ -310,9 +299,9 @@ bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet&
 // The shadow ray both closest hits start with: from HitWorldPosition() towards the light.
 template <typename T>
 bool TraceShadowRayTowardsLight(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
-                                const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth) {
+                                const Effects& effects, const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth) {
     const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
-    return TraceShadowRayAndReportIfHit(ctx, traceRay, maxDepth, hitPosition,
+    return TraceShadowRayAndReportIfHit(ctx, traceRay, maxDepth, effects, hitPosition,
                                         hlsl::normalize(tvec3<T>(vec3(g_sceneCB.lightPosition)) - hitPosition),
                                         recursionDepth);
 }
@@ -331,7 +320,7 @@ tvec4<T> ReflectedColor(ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
 // ---- Entry points ----------------------------------------------------------------------------------
 // Each is a template on the scalar type; results are rounded to float where they cross the interface. Those that
 // trace rays take the library's TraceRay arguments, and those that march or recurse its Accuracy (PORT: constants
-// in the HLSL).
+// in the HLSL); those that trace shadow rays take its Effects.
 
 template <typename T>
 void MyRaygenShader(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy) {
@@ -351,7 +340,7 @@ void MyRaygenShader(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, con
 
 template <typename T>
 void MyClosestHitShader_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                                 RayPayload& rayPayload, const BuiltInTriangleIntersectionAttributes&) {
+                                 const Effects& effects, RayPayload& rayPayload, const BuiltInTriangleIntersectionAttributes&) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
@@ -371,7 +360,7 @@ void MyClosestHitShader_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& 
     // Shadow component.
     const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
     const bool shadowRayHit =
-        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, g_sceneCB, rayPayload.recursionDepth);
+        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, effects, g_sceneCB, rayPayload.recursionDepth);
 
     // Grid lines from the primary camera rays' footprint, even for secondary hits (I7, H4).
     const T checkers = AnalyticalCheckersTexture(
@@ -395,7 +384,7 @@ void MyClosestHitShader_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& 
 
 template <typename T>
 void MyClosestHitShader_AABB(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                             RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
+                             const Effects& effects, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
@@ -403,7 +392,7 @@ void MyClosestHitShader_AABB(ShaderContext& ctx, const TraceRayArgumentSet& trac
 
     const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
     const bool shadowRayHit =
-        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, g_sceneCB, rayPayload.recursionDepth);
+        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, effects, g_sceneCB, rayPayload.recursionDepth);
 
     tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
@@ -488,18 +477,20 @@ void MyIntersectionShader_SignedDistancePrimitive(ShaderContext& ctx, const Accu
 // Every export, with its math in T. The lambdas hold copies of the TraceRay arguments and the Accuracy, which the
 // shaders take by reference.
 template <typename T>
-void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy) {
+void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                const Effects& effects) {
     lib.addRayGeneration("MyRaygenShader",
                          [traceRay, accuracy](ShaderContext& ctx) { MyRaygenShader<T>(ctx, traceRay, accuracy); });
     lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
-        "MyClosestHitShader_Triangle", [traceRay, accuracy](ShaderContext& ctx, RayPayload& payload,
-                                                            const BuiltInTriangleIntersectionAttributes& attr) {
-            MyClosestHitShader_Triangle<T>(ctx, traceRay, accuracy, payload, attr);
+        "MyClosestHitShader_Triangle", [traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
+                                                                     const BuiltInTriangleIntersectionAttributes& attr) {
+            MyClosestHitShader_Triangle<T>(ctx, traceRay, accuracy, effects, payload, attr);
         });
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "MyClosestHitShader_AABB",
-        [traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
-            MyClosestHitShader_AABB<T>(ctx, traceRay, accuracy, payload, attr);
+        [traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
+                                      const ProceduralPrimitiveAttributes& attr) {
+            MyClosestHitShader_AABB<T>(ctx, traceRay, accuracy, effects, payload, attr);
         });
     lib.addMiss<RayPayload>("MyMissShader", MyMissShader);
     lib.addMiss<ShadowRayPayload>("MyMissShader_ShadowRay", MyMissShader_ShadowRay);
@@ -517,10 +508,10 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
 }  // namespace
 
 std::shared_ptr<ShaderLibrary> makeD3D12ShaderLibrary(Precision precision, const TraceRayArgumentSet& traceRay,
-                                                      const Accuracy& accuracy) {
+                                                      const Accuracy& accuracy, const Effects& effects) {
     auto lib = std::make_shared<ShaderLibrary>();
-    if (precision == Precision::Double) addExports<double>(*lib, traceRay, accuracy);
-    else addExports<float>(*lib, traceRay, accuracy);
+    if (precision == Precision::Double) addExports<double>(*lib, traceRay, accuracy, effects);
+    else addExports<float>(*lib, traceRay, accuracy, effects);
     return lib;
 }
 

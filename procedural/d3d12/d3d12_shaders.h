@@ -24,6 +24,7 @@
 #include "emulator/root_signature.h"
 #include "emulator/state_object.h"
 #include "procedural/accuracy.h"
+#include "procedural/effects.h"
 #include "procedural/math/fractals.h"
 #include "procedural/math/metaballs.h"
 #include "procedural/precision.h"
@@ -132,6 +133,11 @@ constexpr TraceRayArgumentSet defaultTraceRayArguments() {
                                  TraceRayParameters::InstanceMask};
     return traceRay;
 }
+// The RAY_FLAGs TraceRadianceRay and TraceShadowRayAndReportIfHit pass, per ray type (§1.7).
+inline constexpr std::array<uint32_t, RayType::Count> kTraceRayFlags = {
+    dxr::RAY_FLAG_CULL_BACK_FACING_TRIANGLES,
+    dxr::RAY_FLAG_CULL_BACK_FACING_TRIANGLES | dxr::RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH |
+        dxr::RAY_FLAG_FORCE_OPAQUE | dxr::RAY_FLAG_SKIP_CLOSEST_HIT_SHADER};
 
 // primitiveType per intersection shader.
 namespace AnalyticPrimitive {
@@ -180,9 +186,11 @@ std::vector<std::string> aabbHitGroupNames();
 // PORT: `traceRay` holds the TraceRay arguments the HLSL compiles in as constants, per ray type; the default is the
 // HLSL's. Other values reproduce the shaders compiled with other constants (IDX-1, IDX-7).
 // PORT: `accuracy` replaces the HLSL's march constants (procedural/accuracy.h); the default is the HLSL's.
+// PORT: `effects` switches call sites off (procedural/effects.h): with traceShadowRays false, both closest hits take
+// every point as lit without tracing; the default is the HLSL's.
 std::shared_ptr<dxr::ShaderLibrary> makeD3D12ShaderLibrary(
     Precision precision = Precision::Float, const TraceRayArgumentSet& traceRay = defaultTraceRayArguments(),
-    const Accuracy& accuracy = {});
+    const Accuracy& accuracy = {}, const Effects& effects = {});
 
 // ---- The ground plane's index and vertex buffers (§1.2) ----------------------------------------------
 // What the app uploads as g_indices (6 16-bit indices, a raw view) and g_vertices (4 vertices, stride 24), which
@@ -228,10 +236,8 @@ glm::vec<4, T> ApplyVisibilityFalloff(glm::vec<4, T> color, T t);
 // PORT: each value is a constant of the HLSL; Accuracy{} gives exactly those constants, so every march is the
 // HLSL's bit for bit. Factors multiply in T (scaledConstant), step counts round with scaledSteps.
 
-// MyIntersectionShader_SignedDistancePrimitive's sphere tracing: threshold 1e-4 x thresholdFactor,
-// 512 x stepsFactor steps, tetrahedral offset 0.5773e-4 x normalEpsilonFactor; stepScale is the material's.
-template <typename T>
-math::SphereTraceParams<T> sphereTraceParams(const Accuracy& accuracy, T stepScale);
+// The SDF intersection shader's sphere tracing with the knobs (one conversion for both libraries: math/sdf.h).
+using math::sphereTraceParams;
 
 // MyIntersectionShader_VolumetricPrimitive's march: metaballSteps (128) samples, central-difference step
 // 0.5773e-5 x normalEpsilonFactor.

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "procedural/accuracy.h"
 #include "procedural/math/hlsl.h"
 #include "procedural/math/ray.h"
 
@@ -241,6 +242,19 @@ struct SphereTraceParams {
     T stepScale = T(1);
     T normalOffset = tetrahedralOffset<T>();
 };
+
+// The sphere tracing of both libraries' SDF intersection shaders with the accuracy knobs applied: threshold
+// 1e-4 x thresholdFactor, 512 x stepsFactor steps, tetrahedral offset 0.5773e-4 x normalEpsilonFactor; stepScale is
+// the material's. Accuracy{} gives the HLSL's constants bit for bit.
+template <typename T>
+SphereTraceParams<T> sphereTraceParams(const Accuracy& accuracy, T stepScale) {
+    SphereTraceParams<T> params;  // the HLSL's constants
+    params.threshold = scaledConstant(params.threshold, accuracy.thresholdFactor);
+    params.maxSteps = scaledSteps(params.maxSteps, accuracy.stepsFactor);
+    params.stepScale = stepScale;
+    params.normalOffset = scaledConstant(params.normalOffset, accuracy.normalEpsilonFactor);
+    return params;
+}
 
 template <typename T>
 struct SphereTraceResult {

@@ -128,16 +128,6 @@ REFRAY_INSTANTIATE_HELPERS(double)
 // ---- Accuracy knobs --------------------------------------------------------------------------------
 
 template <typename T>
-math::SphereTraceParams<T> sphereTraceParams(const Accuracy& accuracy, T stepScale) {
-    math::SphereTraceParams<T> params;  // the HLSL's constants
-    params.threshold = scaledConstant(params.threshold, accuracy.thresholdFactor);
-    params.maxSteps = scaledSteps(params.maxSteps, accuracy.stepsFactor);
-    params.stepScale = stepScale;
-    params.normalOffset = scaledConstant(params.normalOffset, accuracy.normalEpsilonFactor);
-    return params;
-}
-
-template <typename T>
 math::mandelbulb::MandelbulbParams<T> mandelbulbParams(const Accuracy& accuracy) {
     math::mandelbulb::MandelbulbParams<T> params;  // the HLSL's constants
     params.threshold = scaledConstant(params.threshold, accuracy.thresholdFactor);
@@ -166,7 +156,6 @@ uint32_t maxRayRecursionDepth(const Accuracy& accuracy) {
 }
 
 #define REFRAY_INSTANTIATE_KNOBS(T)                                                                     \
-    template math::SphereTraceParams<T> sphereTraceParams<T>(const Accuracy&, T);                       \
     template math::mandelbulb::MandelbulbParams<T> mandelbulbParams<T>(const Accuracy&);                \
     template math::julia::JuliaParams<T> juliaParams<T>(const Accuracy&);
 REFRAY_INSTANTIATE_KNOBS(float)
@@ -273,7 +262,8 @@ tvec4<T> CalculatePhongLighting(const ShaderContext& ctx, const SceneConstantBuf
 // PORT: the HLSL passes the constants kInstanceMask, <ray type>, RayTypeCount, <ray type>; here they come from
 // `traceRay` (the library's TraceRayArgumentSet, those same values by default), which every caller passes down.
 // PORT: MAX_RAY_RECURSION_DEPTH is the library's `maxDepth` (maxRayRecursionDepth of its Accuracy), passed down
-// the same way.
+// the same way; so is the library's Effects, whose traceShadowRays false makes every shadow call site return "not in
+// shadow" untraced, as at that depth.
 template <typename T>
 tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
                           const tvec3<T>& origin, const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
@@ -281,7 +271,7 @@ tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRa
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     RayPayload rayPayload{vec4(0.0f), currentRayRecursionDepth + 1, 0.0f, 0, 0};
     const TraceRayArguments& radiance = traceRay[Radiance];
-    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_CULL_BACK_FACING_TRIANGLES,
+    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[Radiance],
                  radiance.instanceInclusionMask, /*RayContributionToHitGroupIndex*/ radiance.rayContribution,
                  /*MultiplierForGeometryContribution*/ radiance.multiplier,
                  /*MissShaderIndex*/ radiance.missShaderIndex, rayDesc, rayPayload);
@@ -290,16 +280,15 @@ tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRa
 
 template <typename T>
 bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
-                                  const tvec3<T>& origin, const tvec3<T>& direction,
+                                  const Effects& effects, const tvec3<T>& origin, const tvec3<T>& direction,
                                   uint32_t currentRayRecursionDepth) {
     if (currentRayRecursionDepth >= maxDepth) return false;
+    if (!effects.traceShadowRays) return false;  // PORT: shadows switched off (procedural/effects.h)
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     // Starts as "hit": closest-hit and any-hit shaders are skipped, only Miss_Shadow clears it.
     ShadowRayPayload shadowPayload{0.0f, 1};
     const TraceRayArguments& shadow = traceRay[Shadow];
-    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure),
-                 RAY_FLAG_CULL_BACK_FACING_TRIANGLES | RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_FORCE_OPAQUE |
-                     RAY_FLAG_SKIP_CLOSEST_HIT_SHADER,
+    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[Shadow],
                  shadow.instanceInclusionMask, /*RayContributionToHitGroupIndex*/ shadow.rayContribution,
                  /*MultiplierForGeometryContribution*/ shadow.multiplier, /*MissShaderIndex*/ shadow.missShaderIndex,
                  rayDesc, shadowPayload);
@@ -309,9 +298,9 @@ bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet&
 // The shadow test every lit closest hit starts with: from HitWorldPosition() towards the light.
 template <typename T>
 bool TraceShadowRayTowardsLight(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
-                                const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth) {
+                                const Effects& effects, const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth) {
     const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
-    return TraceShadowRayAndReportIfHit(ctx, traceRay, maxDepth, hitPosition,
+    return TraceShadowRayAndReportIfHit(ctx, traceRay, maxDepth, effects, hitPosition,
                                         hlsl::normalize(tvec3<T>(g_sceneCB.lightPosition) - hitPosition),
                                         recursionDepth);
 }
@@ -343,7 +332,7 @@ constexpr ProceduralPrimitiveAttributes kInitialAttributes{vec3(0.0f), vec4(0.0f
 // ---- Entry points ----------------------------------------------------------------------------------
 // Each is a template on the scalar type; results are rounded to float where they cross the interface. Those that
 // trace rays take the library's TraceRay arguments, and those that march or recurse its Accuracy (PORT: constants
-// in the HLSL).
+// in the HLSL); those that trace shadow rays take its Effects.
 
 template <typename T>
 void Raygen(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy) {
@@ -373,7 +362,7 @@ void Miss_Shadow(ShaderContext&, ShadowRayPayload& rayPayload) {
 
 template <typename T>
 void ClosestHit_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                         RayPayload& rayPayload, const BuiltInTriangleIntersectionAttributes&) {
+                         const Effects& effects, RayPayload& rayPayload, const BuiltInTriangleIntersectionAttributes&) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     if (g_sceneCB.debugFlag) {
@@ -398,7 +387,7 @@ void ClosestHit_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay
 
     const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
     const bool shadowRayHit =
-        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, g_sceneCB, rayPayload.recursionDepth);
+        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, effects, g_sceneCB, rayPayload.recursionDepth);
 
     const tvec4<T> albedo = tvec4<T>(l_materialCB.albedo);
     tvec4<T> reflectedColor(T(0));
@@ -447,7 +436,7 @@ void Intersection_Pacman(ShaderContext& ctx, const Accuracy& accuracy) {
 
 template <typename T>
 void ClosestHit_Pacman(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                       RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
+                       const Effects& effects, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
     [[maybe_unused]] PrecisionScope<T> scope;
     if (ctx.HitKind() == 1) {
         rayPayload.color = vec4(0.0f, 0.0f, 1.0f, 0.0f);
@@ -460,7 +449,7 @@ void ClosestHit_Pacman(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, 
 
     const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
     const bool shadowRayHit =
-        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, g_sceneCB, rayPayload.recursionDepth);
+        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, effects, g_sceneCB, rayPayload.recursionDepth);
 
     tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
@@ -597,14 +586,15 @@ void ClosestHit_Julia(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, c
 // Every export, with its math in T. The lambdas hold copies of the TraceRay arguments and the Accuracy, which the
 // shaders take by reference.
 template <typename T>
-void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy) {
+void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                const Effects& effects) {
     lib.addRayGeneration("Raygen", [traceRay, accuracy](ShaderContext& ctx) { Raygen<T>(ctx, traceRay, accuracy); });
     lib.addMiss<RayPayload>("Miss", Miss);
     lib.addMiss<ShadowRayPayload>("Miss_Shadow", Miss_Shadow);
     lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
-        "ClosestHit_Triangle", [traceRay, accuracy](ShaderContext& ctx, RayPayload& payload,
-                                                    const BuiltInTriangleIntersectionAttributes& attr) {
-            ClosestHit_Triangle<T>(ctx, traceRay, accuracy, payload, attr);
+        "ClosestHit_Triangle", [traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
+                                                             const BuiltInTriangleIntersectionAttributes& attr) {
+            ClosestHit_Triangle<T>(ctx, traceRay, accuracy, effects, payload, attr);
         });
     lib.addIntersection<ProceduralPrimitiveAttributes>(
         "Intersection_Julia", [accuracy](ShaderContext& ctx) { Intersection_Julia<T>(ctx, accuracy); });
@@ -617,8 +607,9 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
         "Intersection_Pacman", [accuracy](ShaderContext& ctx) { Intersection_Pacman<T>(ctx, accuracy); });
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Pacman",
-        [traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
-            ClosestHit_Pacman<T>(ctx, traceRay, accuracy, payload, attr);
+        [traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
+                                      const ProceduralPrimitiveAttributes& attr) {
+            ClosestHit_Pacman<T>(ctx, traceRay, accuracy, effects, payload, attr);
         });
     lib.addIntersection<ProceduralPrimitiveAttributes>(
         "Intersection_Mandelbulb", [accuracy](ShaderContext& ctx) { Intersection_Mandelbulb<T>(ctx, accuracy); });
@@ -632,10 +623,10 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
 }  // namespace
 
 std::shared_ptr<ShaderLibrary> makeProcedurayShaderLibrary(Precision precision, const TraceRayArgumentSet& traceRay,
-                                                      const Accuracy& accuracy) {
+                                                      const Accuracy& accuracy, const Effects& effects) {
     auto lib = std::make_shared<ShaderLibrary>();
-    if (precision == Precision::Double) addExports<double>(*lib, traceRay, accuracy);
-    else addExports<float>(*lib, traceRay, accuracy);
+    if (precision == Precision::Double) addExports<double>(*lib, traceRay, accuracy, effects);
+    else addExports<float>(*lib, traceRay, accuracy, effects);
     return lib;
 }
 

@@ -23,6 +23,7 @@
 #include "emulator/root_signature.h"
 #include "emulator/state_object.h"
 #include "procedural/accuracy.h"
+#include "procedural/effects.h"
 #include "procedural/math/fractals.h"
 #include "procedural/precision.h"
 #include "procedural/sample_layout.h"
@@ -120,6 +121,11 @@ constexpr TraceRayArgumentSet defaultTraceRayArguments() {
     traceRay[Shadow] = {Shadow, RayTypeCount, Shadow, kInstanceMask};
     return traceRay;
 }
+// The RAY_FLAGs TraceRadianceRay and TraceShadowRayAndReportIfHit pass, per ray type (§1.4).
+inline constexpr std::array<uint32_t, RayTypeCount> kTraceRayFlags = {
+    dxr::RAY_FLAG_CULL_BACK_FACING_TRIANGLES,
+    dxr::RAY_FLAG_CULL_BACK_FACING_TRIANGLES | dxr::RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH |
+        dxr::RAY_FLAG_FORCE_OPAQUE | dxr::RAY_FLAG_SKIP_CLOSEST_HIT_SHADER};
 inline constexpr vec4 kBackgroundColor{0.6f, 0.7f, 0.9f, 1.0f};
 inline constexpr float kInShadowRadiance = 0.35f;
 
@@ -156,9 +162,11 @@ std::vector<dxr::HitGroupDesc> procedurayHitGroups();
 // PORT: `traceRay` holds the TraceRay arguments the HLSL compiles in as constants, per ray type; the default is the
 // HLSL's. Other values reproduce the shaders compiled with other constants (IDX-1, IDX-7).
 // PORT: `accuracy` replaces the HLSL's march constants (procedural/accuracy.h); the default is the HLSL's.
+// PORT: `effects` switches call sites off (procedural/effects.h): with traceShadowRays false, ClosestHit_Triangle and
+// ClosestHit_Pacman take every point as lit without tracing; the default is the HLSL's.
 std::shared_ptr<dxr::ShaderLibrary> makeProcedurayShaderLibrary(
     Precision precision = Precision::Float, const TraceRayArgumentSet& traceRay = defaultTraceRayArguments(),
-    const Accuracy& accuracy = {});
+    const Accuracy& accuracy = {}, const Effects& effects = {});
 
 // ---- The slab's index and vertex buffers (§1.1) ----------------------------------------------------
 // What the scene uploads as g_indices (36 16-bit indices = 18 dwords, a raw view) and g_vertices (8 vertices,
@@ -184,10 +192,8 @@ glm::vec<4, T> MandelbulbSurfaceColor(glm::vec<3, T> D, glm::vec<3, T> N, glm::v
 // PORT: each value is a constant of the HLSL; Accuracy{} gives exactly those constants, so every march is the
 // HLSL's bit for bit. Factors multiply in T (scaledConstant), step counts round with scaledSteps.
 
-// Intersection_Pacman's sphere tracing: threshold 1e-4 x thresholdFactor, 512 x stepsFactor steps, tetrahedral
-// offset 0.5773e-4 x normalEpsilonFactor; stepScale is the material's.
-template <typename T>
-math::SphereTraceParams<T> sphereTraceParams(const Accuracy& accuracy, T stepScale);
+// The SDF intersection shader's sphere tracing with the knobs (one conversion for both libraries: math/sdf.h).
+using math::sphereTraceParams;
 
 // Intersection_Mandelbulb's march: threshold 1e-4 x thresholdFactor, mandelbulbIterations (4), tetrahedral offset
 // 0.5773e-4 x normalEpsilonFactor.

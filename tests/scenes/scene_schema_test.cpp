@@ -551,6 +551,20 @@ TEST(SceneSchema, MissingRequiredKeysFail) {
                   "\"closestHit\"", "missing required key 'intersection'"});
 }
 
+TEST(SceneSchema, EffectsBlockValidatesAndBadOnesFail) {
+    const std::string text =
+        edited(documentedExample(), "\"imageSize\":", "\"effects\": {\"shadows\": false, \"reflectionDepth\": 2}, \"imageSize\":");
+    const std::vector<std::string> errors = schemaErrors(text, "effects.json");
+    EXPECT_TRUE(errors.empty()) << joinedLines(errors);
+    EXPECT_EQ(loadError(text), "");
+    expectBroken({"effects typo", "\"imageSize\":", "\"effects\": {\"shadow\": false}, \"imageSize\":",
+                  "unknown key 'shadow'"});
+    expectBroken({"effects shadows type", "\"imageSize\":", "\"effects\": {\"shadows\": 0}, \"imageSize\":",
+                  "expected boolean, got a number"});
+    expectBroken({"effects depth range", "\"imageSize\":", "\"effects\": {\"reflectionDepth\": 0}, \"imageSize\":",
+                  "is below the minimum 1"});
+}
+
 TEST(SceneSchema, LayoutRulesFail) {
     // Auto layout computes contributions; explicit layout needs the table and a contribution per instance.
     expectBroken({"contribution in auto layout", "\"blas\": \"SpheresBox\", \"mask\": 1,",

@@ -60,9 +60,13 @@ TEST(Knobs, SetTheAccuracyFieldsAndSpellDefaultsOut) {
 
 TEST(Knobs, TheHlslValueIsTheDefaultHoweverItIsWritten) {
     RenderSettings s;
-    applyKnobList(s, "julia-iterations=200,recursion-depth=3,steps=1,spp=1,precision=float");
+    applyKnobList(s, "julia-iterations=200,steps=1,spp=1,precision=float");
     EXPECT_TRUE(s.accuracy.isDefault());
     EXPECT_EQ(describeKnobs(s), "defaults");
+    // recursion-depth keeps an explicit 3: it overrides a scene's effects block.
+    applyKnob(s, "recursion-depth", "3");
+    EXPECT_EQ(s.accuracy.maxRecursionDepth, 3u);
+    EXPECT_EQ(describeKnobs(s), "recursion-depth=3");
 }
 
 TEST(Knobs, BadNamesAndValuesAreClearErrors) {

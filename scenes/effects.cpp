@@ -1,0 +1,434 @@
+#include "scenes/effects.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "core/strings.h"
+#include "scenes/shader_libraries.h"
+
+namespace refray::scenes {
+
+namespace {
+
+using dxr::HitGroupDesc;
+
+// The parts appended in order (GCC 12's -Wrestrict misfires on "literal" + string + "literal" chains).
+template <class... Parts>
+std::string concat(const Parts&... parts) {
+    std::string text;
+    ((text += parts), ...);
+    return text;
+}
+
+std::string quotedList(const std::vector<std::string>& names) {
+    std::vector<std::string> quoted;
+    for (const std::string& n : names) quoted.push_back(inQuotes(n));
+    return joined(quoted);
+}
+
+// "1 triangle geometry", "3 AABB geometries".
+std::string counted(size_t n, const std::string& singular, const std::string& plural) {
+    std::string text = std::to_string(n);
+    text += ' ';
+    text += n == 1 ? singular : plural;
+    return text;
+}
+
+Effect effect(const char* name, bool on, std::string reason) { return {name, on, std::move(reason)}; }
+
+const HitGroupDesc* findHitGroup(const SceneDesc& scene, const std::string& name) {
+    for (const HitGroupDesc& g : scene.hitGroups)
+        if (g.HitGroupExport == name) return &g;
+    return nullptr;
+}
+
+// The hit groups the hit-group records name, in record order (a NULL record names none).
+std::vector<const HitGroupDesc*> referencedHitGroups(const SceneDesc& scene) {
+    std::vector<const HitGroupDesc*> groups;
+    for (const RecordDesc& r : scene.hitGroupRecords) {
+        const HitGroupDesc* g = r.hitGroup.empty() ? nullptr : findHitGroup(scene, r.hitGroup);
+        if (g && std::find(groups.begin(), groups.end(), g) == groups.end()) groups.push_back(g);
+    }
+    return groups;
+}
+
+bool hitGroupRuns(const HitGroupDesc& g, const std::string& exportName) {
+    return g.ClosestHitShaderImport == exportName || g.AnyHitShaderImport == exportName ||
+           g.IntersectionShaderImport == exportName;
+}
+
+// Whether record `r` passes a use's material gate: the root-constant field named gateField, where the record's
+// struct has one, must exceed gateAbove. A record without the field cannot be decided and counts as passing.
+bool passesGate(const SceneDesc& scene, const RecordDesc& r, const ShaderEffectUse& use) {
+    for (const RecordDesc::Argument& a : r.arguments) {
+        if (a.structIndex < 0) continue;
+        for (const StructField& f : scene.structs[size_t(a.structIndex)].fields) {
+            if (f.name != use.gateField || f.kind != StructField::Kind::Float || f.offset >= a.dwords.size()) continue;
+            float value;
+            std::memcpy(&value, &a.dwords[f.offset], sizeof value);
+            return value > use.gateAbove;
+        }
+    }
+    return true;
+}
+
+// Which exports of the library do `effect` in this scene: the ray generation shader, or a shader of a hit group a
+// record names (and whose material passes the use's gate).
+struct Activity {
+    bool libraryHasIt = false;            // some export of the library does it
+    std::vector<std::string> exports;     // those the scene runs, facts order
+    std::vector<std::string> described;   // "export (what)" or "export"
+    std::string gateField;
+    float gateAbove = 0.0f;
+    size_t gatedRecords = 0, passingRecords = 0;
+};
+
+Activity activity(const SceneDesc& scene, const ShaderLibraryFacts& facts, ShaderEffect which) {
+    Activity a;
+    for (const ShaderEffectUse& use : facts.uses) {
+        if (use.effect != which) continue;
+        a.libraryHasIt = true;
+        bool active = use.exportName == scene.rayGeneration;
+        for (const RecordDesc& r : scene.hitGroupRecords) {
+            const HitGroupDesc* g = r.hitGroup.empty() ? nullptr : findHitGroup(scene, r.hitGroup);
+            if (!g || !hitGroupRuns(*g, use.exportName)) continue;
+            if (use.gateField.empty()) {
+                active = true;
+                continue;
+            }
+            a.gateField = use.gateField;
+            a.gateAbove = use.gateAbove;
+            ++a.gatedRecords;
+            if (passesGate(scene, r, use)) {
+                ++a.passingRecords;
+                active = true;
+            }
+        }
+        if (!active || std::find(a.exports.begin(), a.exports.end(), use.exportName) != a.exports.end()) continue;
+        a.exports.push_back(use.exportName);
+        a.described.push_back(use.what.empty() ? use.exportName : concat(use.exportName, " (", use.what, ")"));
+    }
+    return a;
+}
+
+// "X does", "X, Y do".
+std::string subject(const std::vector<std::string>& names, const char* singularVerb, const char* pluralVerb) {
+    std::string text = joined(names);
+    text += ' ';
+    text += names.size() == 1 ? singularVerb : pluralVerb;
+    return text;
+}
+
+// Why a shader effect is off when no export the scene runs does it.
+std::string notRun(const Activity& a, const SceneDesc& scene, const char* what) {
+    std::string text;
+    if (!a.libraryHasIt) {
+        text = "no shader of library ";
+        text += inQuotes(scene.shaderLibrary);
+        text += ' ';
+        text += what;
+        return text;
+    }
+    if (a.gatedRecords > 0) {
+        text = "no record that runs a shader which ";
+        text += what;
+        text += " has ";
+        text += a.gateField;
+        text += " > ";
+        text += shortestFloat(a.gateAbove);
+        return text;
+    }
+    text = "no shader the scene runs ";
+    text += what;
+    return text;
+}
+
+// Geometry of one type in the BLASes of the instances some ray type can reach (INST-4: mask & inclusion mask).
+Effect geometryEffect(const SceneDesc& scene, dxr::GeometryType type, const char* name, const std::string& kind) {
+    uint32_t rayMask = 0;
+    for (const RayTypeDesc& t : scene.rayTypes) rayMask |= t.instanceInclusionMask;
+    std::vector<std::string> blases, instances;
+    size_t geometries = 0;
+    for (const InstanceDescFile& i : scene.instances) {
+        if ((i.mask & rayMask & 0xFFu) == 0) continue;
+        const BlasDesc& blas = scene.blases[i.blas];
+        size_t n = 0;
+        for (const GeometryDescFile& g : blas.geometries) n += g.type == type ? 1 : 0;
+        if (n == 0) continue;
+        if (std::find(blases.begin(), blases.end(), blas.name) == blases.end()) {
+            blases.push_back(blas.name);
+            geometries += n;
+        }
+        instances.push_back(i.name);
+    }
+    if (blases.empty()) return effect(name, false, concat("no instance a ray can reach holds ", kind, " geometry"));
+    std::string reason = blases.size() == 1 ? "BLAS " : "BLASes ";
+    reason += quotedList(blases);
+    reason += " (";
+    reason += counted(geometries, concat(kind, " geometry"), concat(kind, " geometries"));
+    reason += ") under ";
+    reason += instances.size() == 1 ? concat("instance ", inQuotes(instances[0])) : counted(instances.size(), "", "instances");
+    return effect(name, true, reason);
+}
+
+Effect anyHitEffect(const SceneDesc& scene) {
+    const std::vector<const HitGroupDesc*> groups = referencedHitGroups(scene);
+    std::vector<std::string> with;
+    for (const HitGroupDesc* g : groups)
+        if (!g->AnyHitShaderImport.empty()) with.push_back(concat(inQuotes(g->HitGroupExport), " (", g->AnyHitShaderImport, ")"));
+    if (!with.empty())
+        return effect("any-hit shaders", true,
+                      concat(with.size() == 1 ? "hit group " : "hit groups ", joined(with), " run an any-hit shader"));
+    if (groups.empty()) return effect("any-hit shaders", false, "no record names a hit group");
+    if (groups.size() == 1)
+        return effect("any-hit shaders", false, concat("hit group ", inQuotes(groups[0]->HitGroupExport), " has no any-hit shader"));
+    return effect("any-hit shaders", false,
+                  concat("none of the ", std::to_string(groups.size()), " hit groups the records name has an any-hit shader"));
+}
+
+Effect cullingEffect(const SceneDesc& scene, const ShaderLibraryFacts& facts, const Effect& triangles) {
+    const char* name = "triangle culling";
+    if (!triangles.on) return effect(name, false, "no triangle geometry");
+    std::vector<std::string> back, front;
+    for (size_t r = 0; r < scene.rayTypes.size() && r < facts.rayFlags.size(); ++r) {
+        if (facts.rayFlags[r] & dxr::RAY_FLAG_CULL_BACK_FACING_TRIANGLES) back.push_back(inQuotes(scene.rayTypes[r].name));
+        if (facts.rayFlags[r] & dxr::RAY_FLAG_CULL_FRONT_FACING_TRIANGLES) front.push_back(inQuotes(scene.rayTypes[r].name));
+    }
+    if (back.empty() && front.empty()) return effect(name, false, "no ray type's TraceRay passes a triangle culling flag");
+    std::vector<std::string> cullable;
+    size_t triangleInstances = 0;
+    for (const InstanceDescFile& i : scene.instances) {
+        bool hasTriangles = false;
+        for (const GeometryDescFile& g : scene.blases[i.blas].geometries)
+            hasTriangles = hasTriangles || g.type == dxr::GeometryType::Triangles;
+        if (!hasTriangles) continue;
+        ++triangleInstances;
+        if (!(i.flags & dxr::INSTANCE_FLAG_TRIANGLE_CULL_DISABLE)) cullable.push_back(inQuotes(i.name));
+    }
+    if (cullable.empty())
+        return effect(name, false, concat("every triangle instance sets TRIANGLE_CULL_DISABLE (",
+                                              counted(triangleInstances, "instance", "instances"), ")"));
+    std::string reason;
+    if (!back.empty()) {
+        reason += joined(back);
+        reason += " rays cull back-facing triangles";
+    }
+    if (!front.empty()) {
+        if (!reason.empty()) reason += "; ";
+        reason += joined(front);
+        reason += " rays cull front-facing triangles";
+    }
+    reason += cullable.size() == 1 ? " of instance " : " of instances ";
+    reason += joined(cullable);
+    return effect(name, true, reason);
+}
+
+std::string depthSource(const SceneDesc& scene, const procedural::Accuracy& knobs) {
+    if (knobs.maxRecursionDepth) return "the recursion-depth knob";
+    if (scene.effects.reflectionDepth) return "the scene's reflectionDepth";
+    return "the HLSL's";
+}
+
+}  // namespace
+
+std::vector<Effect> EffectSet::list() const {
+    return {triangles,     procedural,    anyHit,      triangleCulling,  shadowRays,  reflections,
+            animation,     supersampling, distanceFog, rayDifferentials, debugColours};
+}
+
+procedural::Accuracy libraryAccuracy(const SceneDesc& scene, const procedural::Accuracy& knobs) {
+    procedural::Accuracy accuracy = knobs;
+    if (!accuracy.maxRecursionDepth) accuracy.maxRecursionDepth = scene.effects.reflectionDepth;
+    return accuracy;
+}
+
+procedural::Effects libraryEffects(const SceneDesc& scene) {
+    procedural::Effects effects;
+    effects.traceShadowRays = scene.effects.shadows;
+    return effects;
+}
+
+uint32_t pipelineRecursionDepth(const SceneDesc& scene, const procedural::Accuracy& accuracy) {
+    return std::max(scene.maxRecursionDepth, accuracy.maxRecursionDepth.value_or(0));
+}
+
+std::string describeEffectsBlock(const EffectsDesc& block) {
+    std::string text;
+    if (!block.shadows) text += "shadows=off";
+    if (block.reflectionDepth) {
+        if (!text.empty()) text += ',';
+        text += "reflectionDepth=";
+        text += std::to_string(*block.reflectionDepth);
+    }
+    return text.empty() ? "defaults" : text;
+}
+
+EffectSet computeEffects(const SceneDesc& scene, const RenderSettings& settings) {
+    const ShaderLibraryFacts& facts = findShaderLibrary(scene.shaderLibrary).facts;
+    const procedural::Accuracy accuracy = libraryAccuracy(scene, settings.accuracy);
+    EffectSet e;
+    e.recursionDepth = accuracy.maxRecursionDepth.value_or(facts.maxRayRecursionDepth);
+    e.pipelineRecursionDepth = pipelineRecursionDepth(scene, accuracy);
+    e.spp = settings.spp;
+    std::string depthText = "MAX_RAY_RECURSION_DEPTH ";
+    depthText += std::to_string(e.recursionDepth);
+    depthText += " (";
+    depthText += depthSource(scene, settings.accuracy);
+    depthText += ')';
+
+    // Geometry and the pipeline's shader stages.
+    e.triangles = geometryEffect(scene, dxr::GeometryType::Triangles, "triangles", "triangle");
+    e.procedural = geometryEffect(scene, dxr::GeometryType::ProceduralPrimitiveAABBs, "procedural primitives", "AABB");
+    e.anyHit = anyHitEffect(scene);
+    e.triangleCulling = cullingEffect(scene, facts, e.triangles);
+
+    // Shadow rays: traced by closest hits at depth d < MAX_RAY_RECURSION_DEPTH, unless switched off.
+    {
+        const Activity a = activity(scene, facts, ShaderEffect::ShadowRays);
+        const char* name = "shadow rays";
+        if (a.exports.empty()) {
+            e.shadowRays = effect(name, false, notRun(a, scene, "traces shadow rays"));
+        } else if (!scene.effects.shadows) {
+            e.shadowRays = effect(name, false, concat("the scene's effects block sets \"shadows\": false, so ",
+                                                          subject(a.exports, "takes", "take"), " every point as lit"));
+        } else if (e.recursionDepth < 2) {
+            e.shadowRays = effect(name, false, concat(depthText, ": hits at depth 1 trace no shadow rays"));
+        } else {
+            std::string reason = subject(a.exports, "traces", "trace");
+            reason += ' ';
+            reason += scene.rayTypes.size() > facts.shadowRayType ? inQuotes(scene.rayTypes[facts.shadowRayType].name)
+                                                                  : std::string("shadow");
+            reason += " rays towards the light from hits at depth 1";
+            if (e.recursionDepth > 2) {
+                reason += "..";
+                reason += std::to_string(e.recursionDepth - 1);
+            }
+            reason += ", ";
+            reason += depthText;
+            e.shadowRays = effect(name, true, reason);
+        }
+    }
+
+    // Reflections: radiance rays from closest hits, up to MAX_RAY_RECURSION_DEPTH levels in all.
+    {
+        const Activity a = activity(scene, facts, ShaderEffect::Reflections);
+        const char* name = "reflections";
+        if (a.exports.empty()) {
+            e.reflections = effect(name, false, notRun(a, scene, "traces reflection rays"));
+        } else if (e.recursionDepth < 2) {
+            e.reflections = effect(name, false, concat(depthText, ": hits at depth 1 trace no reflection rays"));
+        } else {
+            std::string reason = subject(a.exports, "traces", "trace");
+            reason += " them";
+            if (a.gatedRecords > 0) {
+                reason += " (";
+                reason += a.gateField;
+                reason += " > ";
+                reason += shortestFloat(a.gateAbove);
+                reason += " in ";
+                reason += std::to_string(a.passingRecords);
+                reason += " of ";
+                reason += std::to_string(a.gatedRecords);
+                reason += " records)";
+            }
+            reason += ", ";
+            reason += std::to_string(e.recursionDepth - 1);
+            reason += e.recursionDepth == 2 ? " bounce: " : " bounces: ";
+            reason += depthText;
+            reason += ", pipeline MaxTraceRecursionDepth ";
+            reason += std::to_string(e.pipelineRecursionDepth);
+            e.reflections = effect(name, true, reason);
+        }
+    }
+
+    // Animation: a shader the scene runs reads elapsedTime, or a primitiveTransforms buffer spins.
+    {
+        const Activity a = activity(scene, facts, ShaderEffect::Animation);
+        std::vector<std::string> parts;
+        for (const BufferDesc& b : scene.buffers) {
+            if (b.kind != BufferDesc::Kind::PrimitiveTransforms) continue;
+            size_t spinning = 0;
+            for (const PrimitiveTransformDesc& p : b.primitives) spinning += p.spinYPerSecond != 0.0 ? 1 : 0;
+            if (spinning > 0)
+                parts.push_back(concat("buffer ", inQuotes(b.name), " spins ", counted(spinning, "primitive", "primitives")));
+        }
+        if (!a.exports.empty()) parts.push_back(concat(subject(a.described, "reads", "read"), " elapsedTime"));
+        if (parts.empty())
+            e.animation = effect("animation", false,
+                                 "no shader the scene runs reads elapsedTime and no primitiveTransforms buffer spins");
+        else
+            e.animation = effect("animation", true, joined(parts, "; "));
+    }
+
+    // Supersampling.
+    {
+        uint32_t k = 1;
+        while ((k + 1) * (k + 1) <= settings.spp) ++k;
+        std::string reason = "spp ";
+        reason += std::to_string(settings.spp);
+        if (settings.spp > 1) {
+            reason += ": ";
+            reason += std::to_string(k);
+            reason += 'x';
+            reason += std::to_string(k);
+            reason += " camera rays per pixel, averaged";
+        } else {
+            reason += ": one camera ray per pixel";
+        }
+        e.supersampling = effect("supersampling", settings.spp > 1, reason);
+    }
+
+    // The shaders' own effects.
+    {
+        const Activity a = activity(scene, facts, ShaderEffect::DistanceFog);
+        e.distanceFog = a.exports.empty()
+                            ? effect("distance fog", false, notRun(a, scene, "applies distance fog"))
+                            : effect("distance fog", true,
+                                     subject(a.exports, "blends", "blend") +
+                                         " towards the background by hit distance (visibility falloff)");
+    }
+    {
+        const Activity a = activity(scene, facts, ShaderEffect::RayDifferentials);
+        e.rayDifferentials =
+            a.exports.empty()
+                ? effect("ray-differential checkers", false, notRun(a, scene, "filters a texture with ray differentials"))
+                : effect("ray-differential checkers", true,
+                         subject(a.described, "filters", "filter") +
+                             " over the footprint of the neighbouring pixels' camera rays");
+    }
+    {
+        const ShaderLibraryBinding& binding = findShaderLibrary(scene.shaderLibrary);
+        std::vector<std::string> flagged, clear;
+        for (const BufferDesc& b : scene.buffers) {
+            if (b.kind != BufferDesc::Kind::SceneConstants) continue;
+            (b.debugFlag != 0 ? flagged : clear).push_back(inQuotes(b.name));
+        }
+        if (!binding.hasDebugFlag)
+            e.debugColours = effect("debug colours", false,
+                                    concat("library ", inQuotes(scene.shaderLibrary), " has no debugFlag"));
+        else if (!flagged.empty())
+            e.debugColours = effect("debug colours", true,
+                                    concat("debugFlag is set in ", joined(flagged), ": hits report t = 0 in flat colours"));
+        else
+            e.debugColours = effect("debug colours", false,
+                                    clear.empty() ? std::string("no sceneConstants buffer")
+                                                  : concat("debugFlag is 0 in ", joined(clear)));
+    }
+    return e;
+}
+
+std::string describeEffects(const EffectSet& effects) {
+    std::string text;
+    for (const bool on : {true, false})
+        for (const Effect& e : effects.list()) {
+            if (e.on != on) continue;
+            text += on ? "simulated: " : "skipped: ";
+            text += e.name;
+            text += " - ";
+            text += e.reason;
+            text += '\n';
+        }
+    return text;
+}
+
+}  // namespace refray::scenes
