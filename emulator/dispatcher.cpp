@@ -18,15 +18,34 @@
 
 namespace refray::dxr {
 
-void DispatchStats::merge(const DispatchStats& o) {
-    raysTraced += o.raysTraced;
-    candidates += o.candidates;
-    if (raysPerDepth.size() < o.raysPerDepth.size()) raysPerDepth.resize(o.raysPerDepth.size());
-    for (size_t i = 0; i < o.raysPerDepth.size(); ++i) raysPerDepth[i] += o.raysPerDepth[i];
-    for (size_t i = 0; i < invocations.size(); ++i) invocations[i] += o.invocations[i];
-}
-
 namespace detail {
+
+// Exclusive stage times (DispatchOptions::profileStages): at each switch the running section is charged
+// the time since the previous switch. Sections are ProfileStage values; kOutside is time in no stage
+// (the launch loop, tile scheduling), which is not reported.
+struct StageClock {
+    using Clock = std::chrono::steady_clock;
+    static constexpr uint8_t kOutside = uint8_t(kProfileStageCount);
+    Clock::time_point mark = Clock::now();
+    uint8_t section = kOutside;
+    std::array<Clock::duration, kProfileStageCount + 1> spent{};
+
+    // Switches to `next`; returns the section to switch back to.
+    uint8_t enter(uint8_t next) {
+        const Clock::time_point now = Clock::now();
+        spent[section] += now - mark;
+        mark = now;
+        const uint8_t previous = section;
+        section = next;
+        return previous;
+    }
+};
+
+// Invocations of one export on one thread, keyed by the export (names are attached when merging).
+struct ExportCount {
+    const ShaderExport* shader = nullptr;
+    uint64_t count = 0;
+};
 
 struct DispatchState {
     Device* device = nullptr;
@@ -52,7 +71,63 @@ struct ThreadState {
     std::vector<const ShaderExport*> callChain;  // the shaders running on this launch, outermost first
     GpuVirtualAddress lastTlasAddress = 0;  // one-entry cache of the TLAS lookup
     const TopLevelAS* lastTlas = nullptr;
+    // Statistics beyond `stats`, in forms cheap to update; folded into `stats` when the dispatch ends.
+    std::vector<ExportCount> exportCounts;  // in first-call order: a handful of exports, searched linearly
+    bool profiling = false;                 // DispatchOptions::profileStages
+    StageClock clock;
 };
+
+// Charges this thread's time to `stage` while alive, when profiling; otherwise one untaken branch each way.
+class ProfileScope {
+public:
+    ProfileScope(ThreadState& ts, ProfileStage stage) : ts_(ts) {
+        if (ts_.profiling) previous_ = ts_.clock.enter(uint8_t(stage));
+    }
+    ~ProfileScope() {
+        if (ts_.profiling) ts_.clock.enter(previous_);
+    }
+    ProfileScope(const ProfileScope&) = delete;
+    ProfileScope& operator=(const ProfileScope&) = delete;
+
+private:
+    ThreadState& ts_;
+    uint8_t previous_ = StageClock::kOutside;
+};
+
+void countInvocation(ThreadState& ts, const ShaderExport* shader) {
+    for (ExportCount& e : ts.exportCounts)
+        if (e.shader == shader) {
+            ++e.count;
+            return;
+        }
+    ts.exportCounts.push_back({shader, 1});
+}
+
+void countRay(ThreadState& ts, RayTypeKey key, uint32_t depth) {
+    DispatchStats& st = ts.stats;
+    st.raysTraced++;
+    if (st.raysPerDepth.size() <= depth) st.raysPerDepth.resize(depth + 1);
+    st.raysPerDepth[depth]++;
+    RayTypeCounts* type = nullptr;
+    for (RayTypeCounts& t : st.raysPerType)
+        if (t.key == key) {
+            type = &t;
+            break;
+        }
+    if (!type) type = &st.raysPerType.emplace_back(RayTypeCounts{key, {}});
+    if (type->raysPerDepth.size() <= depth) type->raysPerDepth.resize(depth + 1);
+    type->raysPerDepth[depth]++;
+}
+
+// The thread's statistics in DispatchStats form (raysPerType stays unsorted: merge sorts).
+DispatchStats finishedStats(const ThreadState& ts) {
+    DispatchStats st = ts.stats;
+    for (const ExportCount& e : ts.exportCounts) st.invocationsPerExport.push_back({e.shader->name, e.shader->stage, e.count});
+    st.stagesProfiled = ts.profiling;
+    if (ts.profiling)
+        for (size_t i = 0; i < kProfileStageCount; ++i) st.stageSeconds[i] = std::chrono::duration<double>(ts.clock.spent[i]).count();
+    return st;
+}
 
 // Non-local exits (IS-10, AHS-4). They never carry errors and never leave the dispatcher.
 struct IgnoreHitSignal {};
@@ -298,6 +373,7 @@ void checkPayload(ThreadState& ts, const Site& site, const ShaderExport& shader,
 
 void invoke(ThreadState& ts, Invocation& inv, void* payload, const void* attributes) {
     ts.stats.invocations[size_t(inv.stage)]++;
+    countInvocation(ts, inv.shader);
     if (observer(ts)) {
         TraceEvent e = event(ts, TraceEvent::Kind::ShaderCall, inv.depth);
         e.stage = inv.stage;
@@ -310,11 +386,18 @@ void invoke(ThreadState& ts, Invocation& inv, void* payload, const void* attribu
         observer(ts)->onEvent(e);
     }
     ShaderContext ctx(inv);
-    struct ChainEntry {  // pops on every exit, including non-local ones
-        std::vector<const ShaderExport*>& chain;
-        ~ChainEntry() { chain.pop_back(); }
-    } entry{ts.callChain};
+    // On every exit, non-local ones included: pop the call chain and, when profiling, hand the clock back
+    // to the caller's section. One object, so the IgnoreHit / end-search signals unwind one cleanup here.
+    struct ShaderScope {
+        ThreadState& ts;
+        uint8_t callerSection;
+        ~ShaderScope() {
+            ts.callChain.pop_back();
+            if (ts.profiling) ts.clock.enter(callerSection);
+        }
+    };
     ts.callChain.push_back(inv.shader);
+    const ShaderScope scope{ts, ts.profiling ? ts.clock.enter(uint8_t(profileStageOf(inv.stage))) : StageClock::kOutside};
     inv.shader->function(ctx, payload, attributes);
 }
 
@@ -741,9 +824,7 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
     };
     if (observer(ts)) emitRay(TraceEvent::Kind::TraceRay);
 
-    ts.stats.raysTraced++;
-    if (ts.stats.raysPerDepth.size() <= rs.depth) ts.stats.raysPerDepth.resize(rs.depth + 1);
-    ts.stats.raysPerDepth[rs.depth]++;
+    countRay(ts, {r & kRayContributionMask, missIndex & kMissShaderIndexMask}, rs.depth);
     ts.rayCounter++;
 
     // RAY-7: an infinite origin or direction component makes the plain math NaN, so the ray finds nothing;
@@ -964,6 +1045,9 @@ void ShaderContext::traceRay(GpuVirtualAddress as, uint32_t flags, uint32_t mask
                              const RayDesc& ray, void* payload, TypeTag payloadType) {
     if (!(bit(inv_.stage) & (bit(ShaderStage::RayGeneration) | bit(ShaderStage::ClosestHit) | bit(ShaderStage::Miss))))
         stageError(inv_, "RAY-2", "TraceRay() may not be called from a " + std::string(toString(inv_.stage)) + " shader");
+    // Timed here rather than inside detail::traceRay: a cleanup there would lengthen the unwind table that
+    // every end-search signal caught in it walks. The shaders it invokes charge their own time.
+    const detail::ProfileScope traversal(*inv_.thread, ProfileStage::Traversal);
     detail::traceRay(inv_, as, flags, mask, r, m, miss, ray, payload, payloadType);
 }
 
@@ -1171,6 +1255,7 @@ DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObj
         ds.options = options;
     }
     DispatchResult result;
+    result.stats.stagesProfiled = options.profileStages;
     if (!ds.rayGenRecord.entry || threads == 0) {  // REC-8: NULL ray generation; RGS-1: zero size
         result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         return result;
@@ -1182,6 +1267,7 @@ DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObj
         detail::ThreadState ts;
         ts.dispatch = &ds;
         ts.candidates.reserve(64);
+        ts.profiling = options.profileStages;
         return ts;
     });
 
@@ -1233,7 +1319,7 @@ DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObj
     std::vector<Diagnostic> errors;
     for (auto& ts : threadStates) {
         result.diagnostics.merge(ts.log);
-        result.stats.merge(ts.stats);
+        result.stats.merge(detail::finishedStats(ts));
         errors.insert(errors.end(), ts.stopErrors.begin(), ts.stopErrors.end());
     }
     if (!errors.empty()) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/progress.h"
+#include "emulator/dispatch_stats.h"
 #include "emulator/trace.h"
 #include "emulator/validation.h"
 
@@ -47,21 +48,15 @@ struct DispatchOptions {
     std::optional<LaunchRegion> region;
     // Receives every trace event (emulator/trace.h); null: nothing is recorded.
     TraceObserver* observer = nullptr;
-};
-
-struct DispatchStats {
-    uint64_t raysTraced = 0;
-    std::vector<uint64_t> raysPerDepth;  // index = depth of the invoked shaders (1 = primary)
-    std::array<uint64_t, 6> invocations{};  // by ShaderStage
-    uint64_t candidates = 0;
-    void merge(const DispatchStats& other);
-    uint64_t invocationsOf(ShaderStage s) const { return invocations[size_t(s)]; }
+    // Measure the exclusive time of every stage (DispatchStats::stageSeconds) with steady_clock around each
+    // shader call and TraceRay. Off: the stage times stay zero and the cost is one untaken branch per site.
+    bool profileStages = false;
 };
 
 struct DispatchResult {
     DiagnosticLog diagnostics;  // warnings, plus the errors in OnError::Continue mode
     DispatchStats stats;
-    double seconds = 0.0;
+    double seconds = 0.0;  // wall time of the whole dispatch
 };
 
 }  // namespace refray::dxr

@@ -38,6 +38,8 @@ struct RenderSettings {
     std::optional<dxr::LaunchRegion> region;
     // Receives the trace events of the dispatch (emulator/trace.h); null: nothing is recorded.
     dxr::TraceObserver* observer = nullptr;
+    // Time each shader stage and the traversal (DispatchStats::stageSeconds); costs a few per cent when on.
+    bool profileStages = false;
 };
 
 // Runs DispatchRays for a width x height dispatch with the settings' threads, order, error mode and progress.
@@ -51,6 +53,7 @@ inline dxr::DispatchResult dispatchWithSettings(dxr::Device& device, const dxr::
     options.onError = settings.onError;
     options.region = settings.region;
     options.observer = settings.observer;
+    options.profileStages = settings.profileStages;
     std::unique_ptr<Progress> progress;
     if (settings.progress) {
         const uint64_t launches = settings.region ? uint64_t(settings.region->width) * settings.region->height * desc.Depth

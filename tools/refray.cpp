@@ -1,19 +1,24 @@
 // refray: the command line. Only this layer prints and exits.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
+#include <string_view>
 
 #include <CLI/CLI.hpp>
 
 #include "core/error.h"
 #include "core/image.h"
+#include "core/json_writer.h"
 #include "core/strings.h"
 #include "emulator/validation.h"
 #include "procedural/precision.h"
 #include "scenes/builtin_scene.h"
+#include "scenes/effects.h"
 #include "scenes/golden.h"
 #include "scenes/index_map.h"
 #include "scenes/knobs.h"
@@ -35,17 +40,111 @@ using tools::Size;
 using tools::terminalProgress;
 using tools::writeOutput;
 
+// --stats: the lines below "render:" are indented, one block per measure (docs/emulator.md shows an example).
 void printStats(const scenes::RenderResult& r, const Size& size) {
-    const auto& st = r.dispatch.stats;
+    const dxr::DispatchStats& st = r.dispatch.stats;
+    const auto u = [](uint64_t v) { return (unsigned long long)v; };
     std::printf("render: %ux%u in %.3f s, %llu rays (%.0f rays/s)\n", size.width, size.height, r.dispatch.seconds,
-                (unsigned long long)st.raysTraced, r.dispatch.seconds > 0 ? double(st.raysTraced) / r.dispatch.seconds : 0.0);
-    for (size_t d = 1; d < st.raysPerDepth.size(); ++d)
-        std::printf("  rays at depth %zu: %llu\n", d, (unsigned long long)st.raysPerDepth[d]);
+                u(st.raysTraced), r.dispatch.seconds > 0 ? double(st.raysTraced) / r.dispatch.seconds : 0.0);
+    for (size_t d = 1; d < st.raysPerDepth.size(); ++d) std::printf("  rays at depth %zu: %llu\n", d, u(st.raysPerDepth[d]));
+
+    // Ray types x depth.
+    std::printf("  rays per type (R = RayContributionToHitGroupIndex & 0xF, miss = MissShaderIndex) and depth:\n");
+    std::printf("    %-16s %12s", "type", "total");
+    for (size_t d = 1; d < st.raysPerDepth.size(); ++d) std::printf(" %12s", ("depth " + std::to_string(d)).c_str());
+    std::printf("\n");
+    for (const dxr::RayTypeCounts& t : st.raysPerType) {
+        std::printf("    %-16s %12llu", dxr::toString(t.key).c_str(), u(t.total()));
+        for (size_t d = 1; d < st.raysPerDepth.size(); ++d)
+            std::printf(" %12llu", u(d < t.raysPerDepth.size() ? t.raysPerDepth[d] : 0));
+        std::printf("\n");
+    }
+
+    // Invocations per stage, then per export.
     for (size_t s = 0; s < st.invocations.size(); ++s)
         if (st.invocations[s])
-            std::printf("  %s invocations: %llu\n", std::string(dxr::toString(dxr::ShaderStage(s))).c_str(),
-                        (unsigned long long)st.invocations[s]);
-    std::printf("  candidates gathered: %llu\n", (unsigned long long)st.candidates);
+            std::printf("  %s invocations: %llu\n", std::string(dxr::toString(dxr::ShaderStage(s))).c_str(), u(st.invocations[s]));
+    std::printf("  invocations per export:\n");
+    for (const dxr::ExportInvocations& e : st.invocationsPerExport)
+        std::printf("    %-13s %s: %llu\n", std::string(dxr::toString(e.stage)).c_str(), e.exportName.c_str(), u(e.count));
+    std::printf("  candidates gathered: %llu\n", u(st.candidates));
+
+    // Exclusive time per stage.
+    const double total = st.profiledSeconds();
+    if (!st.stagesProfiled) {
+        std::printf("  time per stage: not measured\n");
+        return;
+    }
+    std::printf("  time per stage (exclusive, summed over worker threads): %.3f s\n", total);
+    for (size_t i = 0; i < dxr::kProfileStageCount; ++i) {
+        const auto stage = dxr::ProfileStage(i);
+        const bool ran = stage == dxr::ProfileStage::Traversal ? st.raysTraced > 0 : st.invocations[i] > 0;
+        if (!ran) continue;
+        std::printf("    %-13s %10.3f s %6.1f%%\n", std::string(dxr::toString(stage)).c_str(), st.secondsIn(stage),
+                    total > 0 ? 100.0 * st.secondsIn(stage) / total : 0.0);
+    }
+}
+
+// --stats-json: the same measures as printStats, as a "refray-stats/1" document; `effects` is empty for the
+// built-in scene.
+std::string statsJson(const scenes::RenderResult& r, const std::string& scene, const Size& size,
+                      const std::vector<scenes::Effect>& effects) {
+    const dxr::DispatchStats& st = r.dispatch.stats;
+    json::Writer w;
+    const auto perDepth = [&w](const std::vector<uint64_t>& rays) {
+        w.beginArray(json::Writer::Layout::Inline);
+        for (size_t d = 1; d < rays.size(); ++d)
+            w.beginObject(json::Writer::Layout::Inline).member("depth", d).member("rays", rays[d]).endObject();
+        w.endArray();
+    };
+    w.beginObject();
+    w.member("format", "refray-stats/1").member("scene", scene).member("width", size.width).member("height", size.height);
+    w.member("wallSeconds", r.dispatch.seconds).member("raysTraced", st.raysTraced);
+    w.member("raysPerSecond", r.dispatch.seconds > 0 ? double(st.raysTraced) / r.dispatch.seconds : 0.0);
+    w.member("candidates", st.candidates);
+    w.key("raysPerDepth");
+    perDepth(st.raysPerDepth);
+    w.key("rayTypes").beginArray();
+    for (const dxr::RayTypeCounts& t : st.raysPerType) {
+        w.beginObject(json::Writer::Layout::Inline)
+            .member("rayContribution", t.key.rayContribution)
+            .member("missShaderIndex", t.key.missShaderIndex)
+            .member("rays", t.total())
+            .key("raysPerDepth");
+        perDepth(t.raysPerDepth);
+        w.endObject();
+    }
+    w.endArray();
+    w.key("invocations").beginObject(json::Writer::Layout::Inline);
+    for (size_t i = 0; i < st.invocations.size(); ++i) w.member(dxr::toString(dxr::ShaderStage(i)), st.invocations[i]);
+    w.endObject();
+    w.key("invocationsPerExport").beginArray();
+    for (const dxr::ExportInvocations& e : st.invocationsPerExport)
+        w.beginObject(json::Writer::Layout::Inline)
+            .member("export", e.exportName)
+            .member("stage", dxr::toString(e.stage))
+            .member("count", e.count)
+            .endObject();
+    w.endArray();
+    const double total = st.profiledSeconds();
+    w.key("stageTimes").beginObject();
+    w.member("profiled", st.stagesProfiled).member("exclusiveSecondsSummedOverThreads", total);
+    w.key("stages").beginArray();
+    for (size_t i = 0; i < dxr::kProfileStageCount; ++i) {
+        const auto stage = dxr::ProfileStage(i);
+        w.beginObject(json::Writer::Layout::Inline)
+            .member("stage", dxr::toString(stage))
+            .member("seconds", st.secondsIn(stage))
+            .member("share", total > 0 ? st.secondsIn(stage) / total : 0.0)
+            .endObject();
+    }
+    w.endArray().endObject();
+    w.key("effects").beginArray();
+    for (const scenes::Effect& e : effects)
+        w.beginObject(json::Writer::Layout::Inline).member("name", e.name).member("simulated", e.on).member("reason", e.reason).endObject();
+    w.endArray();
+    w.endObject();
+    return w.text() + "\n";
 }
 
 struct RenderOptions {
@@ -54,6 +153,7 @@ struct RenderOptions {
     std::string size;  // empty: the scene's image size
     uint32_t threads = 0;
     bool stats = false;
+    std::string statsJson;  // --stats-json FILE
     std::string order = "ordered";
     uint64_t seed = 0;
     std::string camera;
@@ -102,8 +202,11 @@ int runRender(const RenderOptions& o) {
     settings.precision = *precision;
     settings.spp = o.spp;
     for (const std::string& k : o.knobs) scenes::applyKnobAssignment(settings, k);
+    settings.profileStages = o.stats || !o.statsJson.empty();
 
     scenes::RenderResult result;
+    scenes::EffectSet effectSet;
+    std::vector<scenes::Effect> effects;  // of a scene file (the built-in scene has none to report)
     if (o.scene == "builtin") {
         REFRAY_CHECK(o.camera.empty() && !o.time && o.spp == 1 && o.precision == "float" && o.orderCheck == 0 && o.aov.empty() &&
                          o.knobs.empty(),
@@ -118,6 +221,8 @@ int runRender(const RenderOptions& o) {
         result.image.metadata["traversal_order"] = o.order;
     } else {
         std::unique_ptr<scenes::Scene> scene = scenes::loadScene(o.scene);
+        effectSet = scenes::computeEffects(scene->desc(), settings);
+        effects = effectSet.list();
         const Size size = o.size.empty() ? Size{scene->desc().defaultWidth, scene->desc().defaultHeight} : parseSize(o.size);
         settings.width = size.width, settings.height = size.height;
         if (!o.aov.empty()) {
@@ -144,7 +249,19 @@ int runRender(const RenderOptions& o) {
     result.image.metadata["threads"] = std::to_string(o.threads);
     result.image.metadata["render_seconds"] = std::to_string(result.dispatch.seconds);
     writeOutput(o.output, result.image);
-    if (o.stats) printStats(result, {result.image.width(), result.image.height()});
+    const Size renderedSize{result.image.width(), result.image.height()};
+    if (o.stats) {
+        printStats(result, renderedSize);
+        if (!effects.empty()) {
+            std::printf("  effects:\n");
+            std::istringstream lines(scenes::describeEffects(effectSet));
+            for (std::string line; std::getline(lines, line);) std::printf("    %s\n", line.c_str());
+        }
+    }
+    if (!o.statsJson.empty()) {
+        tools::writeTextFile(o.statsJson, statsJson(result, o.scene, renderedSize, effects));
+        std::printf("wrote %s\n", o.statsJson.c_str());
+    }
     std::printf("wrote %s\n", o.output.c_str());
     return 0;
 }
@@ -178,7 +295,9 @@ int main(int argc, char** argv) {
     render->add_option("--threads", ro.threads, "Worker threads (0: all)")->capture_default_str();
     render->add_option("--order", ro.order, "Traversal order: ordered (default) or adversarial (GEN-3)");
     render->add_option("--seed", ro.seed, "Seed of the adversarial order");
-    render->add_flag("--stats", ro.stats, "Print rays, invocations and timing");
+    render->add_flag("--stats", ro.stats,
+                     "Print rays per ray type and depth, invocations per export, and the exclusive time per stage");
+    render->add_option("--stats-json", ro.statsJson, "Write the --stats measures to FILE as JSON (format refray-stats/1)");
     render->add_option("--aov", ro.aov,
                        "Write an index map instead of the render: record|instance|geometry|primitive|hitgroup|depth "
                        "of each pixel's primary ray, false-coloured, with a legend");
