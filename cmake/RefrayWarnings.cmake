@@ -20,4 +20,13 @@ if(REFRAY_FUZZ)
                                                      -fno-sanitize-recover=undefined)
   target_link_options(refray_sanitizers INTERFACE -fsanitize=address,undefined)
 endif()
-target_link_libraries(refray_warnings INTERFACE refray_sanitizers)
+# Compiler bugs that change refray's numbers. GCC's SLP vectorizer (seen with GCC 12.2 at -O2 and -O3): when it puts
+# two components of double(float(x)) in one vector, value numbering folds the vector conversion pair back to x, so
+# the widened copy keeps the unrounded double and release builds compute other numbers than dev builds. Off for
+# every refray target; it costs no measurable render time. Reproducer: tests/stability/build_mode_test.cpp;
+# evidence: docs/numerical-stability.md, "Build modes".
+add_library(refray_compiler_workarounds INTERFACE)
+if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+  target_compile_options(refray_compiler_workarounds INTERFACE -fno-tree-slp-vectorize)
+endif()
+target_link_libraries(refray_warnings INTERFACE refray_sanitizers refray_compiler_workarounds)

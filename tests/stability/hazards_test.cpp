@@ -25,7 +25,6 @@
 #include "emulator/device.h"
 #include "emulator/intersection.h"
 #include "emulator/shader_api.h"
-#include "emulator/shader_table.h"
 #include "emulator/trace.h"
 #include "procedural/d3d12/d3d12_shaders.h"
 #include "procedural/math/fractals.h"
@@ -35,6 +34,7 @@
 #include "scenes/render_settings.h"
 #include "scenes/scene.h"
 #include "scenes/scene_loader.h"
+#include "tests/emulator/harness.h"
 #include "tests/procedural/contract_support.h"
 #include "tests/procedural/sweep_support.h"
 #include "tests/scenes/scene_test_support.h"
@@ -858,101 +858,44 @@ TEST(HazardFmod, CellEdgesNegativeArgumentsAndFloatAgainstDouble) {
 // 6. Degenerate and NaN triangles, inverted and NaN AABBs, through the emulator (DEGEN-1, -6, -7, -8, TRI-5)
 // =================================================================================================
 
-// A minimal pipeline on the emulator's Device: ray generation traces rays[i] into a Probe; triangles have a
-// closest hit that records the hit; AABBs have an intersection shader that only records that it ran (so IS
-// invocations are counted, never hits); a miss shader counts misses. (tests/emulator/harness.h has the same
-// building blocks, but its .cpp is not part of this test binary.)
-struct DegeneracyProbe {
-    uint32_t hits = 0, misses = 0, primitive = ~0u, instance = ~0u;
-};
-struct NoAttributes {
-    uint32_t unused = 0;
-};
-
+// A minimal pipeline on tests/emulator/harness.h: ray generation traces rays[i] into a Probe; triangles have the
+// harness's recording closest hit (HG_Tri); AABBs have an intersection shader that only records that it ran (so IS
+// invocations are counted, never hits); Miss_Probe counts misses.
 class DegeneracyRig {
 public:
-    dxr::Device device;
+    test::Harness harness;
+    dxr::Device& device = harness.device;
     std::vector<dxr::RayDesc> rays;
-    std::vector<DegeneracyProbe> probes;
+    std::vector<test::Probe> probes;
     std::vector<std::vector<uint32_t>> intersectionCalls;  // per launch: (instance << 16 | primitive) of each IS call
     dxr::GpuVirtualAddress triangleBlas = 0, boxBlas = 0;
 
-    dxr::GeometryDesc triangles(const std::vector<vec3>& vertices) {
-        dxr::GeometryDesc g;
-        g.Type = dxr::GeometryType::Triangles;
-        g.Flags = dxr::GEOMETRY_FLAG_OPAQUE;
-        g.Triangles.VertexFormat = dxr::Format::R32G32B32_FLOAT;
-        g.Triangles.VertexCount = uint32_t(vertices.size());
-        g.Triangles.VertexBuffer = {device.memory().upload(vertices, "hazard vertices"), sizeof(vec3)};
-        return g;
-    }
-    dxr::GeometryDesc aabbs(const std::vector<dxr::RaytracingAABB>& boxes) {
-        dxr::GeometryDesc g;
-        g.Type = dxr::GeometryType::ProceduralPrimitiveAABBs;
-        g.Flags = dxr::GEOMETRY_FLAG_OPAQUE;
-        g.AABBs.AABBCount = boxes.size();
-        g.AABBs.AABBs = {device.memory().upload(boxes, "hazard AABBs"), sizeof(dxr::RaytracingAABB)};
-        return g;
-    }
     // Instance 0: the triangle BLAS (record 0), instance 1: the AABB BLAS (record 1).
-    void build(const dxr::GeometryDesc& tris, const dxr::GeometryDesc& boxes) {
-        triangleBlas = device.buildBottomLevelAS({dxr::BUILD_FLAG_NONE, {tris}});
-        boxBlas = device.buildBottomLevelAS({dxr::BUILD_FLAG_NONE, {boxes}});
-        const std::vector<dxr::InstanceDesc> instances = {
-            dxr::makeInstanceDesc(Matrix3x4::identity(), 0, 0xFF, 0, dxr::INSTANCE_FLAG_NONE, triangleBlas),
-            dxr::makeInstanceDesc(Matrix3x4::identity(), 0, 0xFF, 1, dxr::INSTANCE_FLAG_NONE, boxBlas)};
-        tlas_ = device.buildTopLevelAS(
-            {dxr::BUILD_FLAG_NONE, 2, dxr::ElementsLayout::Array, device.memory().upload(instances, "hazard instances")});
+    void build(const std::vector<vec3>& vertices, const std::vector<dxr::RaytracingAABB>& boxes) {
+        triangleBlas = harness.blas({harness.triangles(vertices)});
+        boxBlas = harness.blas({harness.aabbs(boxes)});
+        harness.tlas({test::Harness::instance(triangleBlas, 0), test::Harness::instance(boxBlas, 1)});
     }
     void trace() {
-        if (!pipeline_) makePipeline();
-        probes.assign(rays.size(), DegeneracyProbe{});
+        if (!pipeline_) {
+            harness.addProbeShaders();
+            harness.library->addIntersection<test::ProbeAttributes>("IS_Record", [this](dxr::ShaderContext& ctx) {
+                intersectionCalls[ctx.DispatchRaysIndex().x].push_back(ctx.InstanceIndex() << 16 | ctx.PrimitiveIndex());
+            });
+            harness.stateObject.hitGroups.push_back(
+                {"HG_Record", dxr::HitGroupType::ProceduralPrimitive, "", "", "IS_Record"});
+            harness.addTracingRayGen([this](uvec3 i) { return rays[i.x]; }, {}, probes);
+            pipeline_ = harness.pipeline();
+        }
+        probes.assign(rays.size(), test::Probe{});
         intersectionCalls.assign(rays.size(), {});
-        dxr::DispatchRaysDesc desc;
-        const auto rg = dxr::ShaderTableBuilder("raygen").addRecord(pipeline_->shaderIdentifier("RG")).upload(device.memory());
-        desc.RayGenerationShaderRecord = {rg.StartAddress, rg.SizeInBytes};
-        desc.MissShaderTable = dxr::ShaderTableBuilder("miss").addRecord(pipeline_->shaderIdentifier("Miss")).upload(device.memory());
-        desc.HitGroupTable = dxr::ShaderTableBuilder("hit groups")
-                                 .addRecord(pipeline_->shaderIdentifier("HG_Triangle"))
-                                 .addRecord(pipeline_->shaderIdentifier("HG_Box"))
-                                 .upload(device.memory());
-        desc.Width = uint32_t(rays.size());
-        desc.Height = 1;
-        desc.Depth = 1;
         dxr::DispatchOptions options;
         options.threads = 2;
-        device.dispatchRays(desc, pipeline_, nullptr, options);
+        harness.dispatch(pipeline_, harness.table(pipeline_, {"Miss_Probe"}),
+                         harness.table(pipeline_, {"HG_Tri", "HG_Record"}), uvec3(uint32_t(rays.size()), 1, 1), options);
     }
 
 private:
-    void makePipeline() {
-        auto library = std::make_shared<dxr::ShaderLibrary>();
-        library->addRayGeneration("RG", [this](dxr::ShaderContext& ctx) {
-            const uint32_t i = ctx.DispatchRaysIndex().x;
-            DegeneracyProbe p;
-            ctx.TraceRay(tlas_, dxr::RAY_FLAG_NONE, 0xFF, 0, 0, 0, rays[i], p);
-            probes[i] = p;
-        });
-        library->addClosestHit<DegeneracyProbe, dxr::BuiltInTriangleIntersectionAttributes>(
-            "CH", [](dxr::ShaderContext& ctx, DegeneracyProbe& p, const dxr::BuiltInTriangleIntersectionAttributes&) {
-                p.hits++;
-                p.primitive = ctx.PrimitiveIndex();
-                p.instance = ctx.InstanceIndex();
-            });
-        library->addIntersection<NoAttributes>("IS", [this](dxr::ShaderContext& ctx) {
-            intersectionCalls[ctx.DispatchRaysIndex().x].push_back(ctx.InstanceIndex() << 16 | ctx.PrimitiveIndex());
-        });
-        library->addMiss<DegeneracyProbe>("Miss", [](dxr::ShaderContext&, DegeneracyProbe& p) { p.misses++; });
-        dxr::StateObjectDesc so;
-        so.name = "hazards";
-        so.libraries = {{library, {}}};
-        so.hitGroups = {{"HG_Triangle", dxr::HitGroupType::Triangles, "", "CH", ""},
-                        {"HG_Box", dxr::HitGroupType::ProceduralPrimitive, "", "", "IS"}};
-        so.shaderConfigs = {{uint32_t(sizeof(DegeneracyProbe)), 32}};
-        so.pipelineConfigs = {{1, dxr::PIPELINE_FLAG_NONE}};
-        pipeline_ = dxr::StateObject::create(so);
-    }
-    dxr::GpuVirtualAddress tlas_ = 0;
     dxr::StateObjectPtr pipeline_;
 };
 
@@ -1005,7 +948,7 @@ TEST(HazardDegenerate, PointAndNaNTrianglesAndInvertedBoxesNeverHit) {
     const std::vector<dxr::RaytracingAABB> boxes = {
         {2, -1, -1, 0, 1, 1}, {4.5f, 1, 1, 3.5f, -1, -1}, {kNaN, -1, -1, 8, 1, 1}, {10, -1, -1, 12, 1, 1}};
     DegeneracyRig rig;
-    rig.build(rig.triangles(vertices), rig.aabbs(boxes));
+    rig.build(vertices, boxes);
     int degen8Warnings = 0;
     for (const dxr::Diagnostic& d : rig.device.buildDiagnostics().diagnostics()) degen8Warnings += d.ruleId == "DEGEN-8";
 
@@ -1040,13 +983,13 @@ TEST(HazardDegenerate, PointAndNaNTrianglesAndInvertedBoxesNeverHit) {
     rig.trace();
     int triangleHits = 0, controlHits = 0, boxCalls = 0, controlCalls = 0, pointCalls = 0, axisRays = 0;
     for (size_t i = 0; i < rig.rays.size(); ++i) {
-        const DegeneracyProbe& p = rig.probes[i];
-        EXPECT_EQ(p.hits + p.misses, 1u) << "ray " << i;
+        const test::Probe& p = rig.probes[i];
+        EXPECT_EQ(p.closestHits + p.misses, 1u) << "ray " << i;
         if (i >= firstControl) {
-            controlHits += p.hits == 1 && p.primitive == 4;
-        } else if (p.hits) {
+            controlHits += p.closestHits == 1 && p.primitiveIndex == 4;
+        } else if (p.closestHits) {
             ++triangleHits;
-            ADD_FAILURE() << "ray " << i << " hit triangle " << p.primitive;
+            ADD_FAILURE() << "ray " << i << " hit triangle " << p.primitiveIndex;
         }
         bool pointCall = false;
         for (const uint32_t call : rig.intersectionCalls[i]) {
@@ -1109,13 +1052,13 @@ TEST(HazardDegenerate, DEGEN_7_CollinearTrianglesNeverHitObliqueRays) {
     std::vector<vec3> vertices;
     for (const auto& t : tris) vertices.insert(vertices.end(), t.begin(), t.end());
     DegeneracyRig rig;
-    rig.build(rig.triangles(vertices), rig.aabbs({{10, -1, -1, 12, 1, 1}}));
+    rig.build(vertices, {{10, -1, -1, 12, 1, 1}});
     std::mt19937 rng(1602);
     for (size_t t = 0; t < 2; ++t)
         for (const dxr::RayDesc& r : raysThrough(tris[t], 300, rng)) rig.rays.push_back(r);
     rig.trace();
     int dispatchHits = 0;
-    for (const DegeneracyProbe& p : rig.probes) dispatchHits += p.hits != 0;
+    for (const test::Probe& p : rig.probes) dispatchHits += p.closestHits != 0;
     int directHits = 0;
     double worstT = 0;
     for (size_t i = 0; i < 2; ++i) {

@@ -13,12 +13,14 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "core/image.h"
 #include "scenes/render_settings.h"
 #include "scenes/scene.h"
 #include "scenes/scene_loader.h"
@@ -177,16 +179,55 @@ Difference compare(const Image& expected, const Image& actual) {
 
 const char* name(Precision precision) { return precision == Precision::Float ? "float" : "double"; }
 
+// The picture of one render's difference from the reference: white where equal, darker by 4 x the largest channel
+// difference (black from 0.25 on), magenta where `actual` is not finite. docs/images/stability/translation-fringe.png
+// is made of these.
+Image differenceImage(const Image& expected, const Image& actual) {
+    Image out(expected.width(), expected.height(), vec4(0, 0, 0, 1));
+    for (uint32_t y = 0; y < expected.height(); ++y)
+        for (uint32_t x = 0; x < expected.width(); ++x) {
+            const vec4 a = actual.at(x, y), e = expected.at(x, y);
+            if (!(std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]))) {
+                out.at(x, y) = vec4(1, 0, 1, 1);
+                continue;
+            }
+            float worst = 0;
+            for (int c = 0; c < 3; ++c)
+                worst = std::max(worst, std::abs(std::clamp(a[c], 0.0f, 1.0f) - std::clamp(e[c], 0.0f, 1.0f)));
+            const float g = 1 - std::min(1.0f, 4 * worst);
+            out.at(x, y) = vec4(g, g, g, 1);
+        }
+    return out;
+}
+
+// "1e3" for 1000, "0" for 0.
+std::string offsetName(double D) {
+    if (D == 0) return "0";
+    char buffer[16];
+    std::snprintf(buffer, sizeof buffer, "1e%d", int(std::lround(std::log10(D))));
+    return buffer;
+}
+
 // Renders `base` at offset 0 and at each D of `offsets` (offset (D, D/2, -D)), prints one line per offset and
-// returns the differences, in the order of `offsets`.
-std::vector<Difference> sweep(const char* label, Layout base, Precision precision, const std::vector<double>& offsets) {
+// returns the differences, in the order of `offsets`. With a `picture` prefix, writes the reference render and each
+// difference image to REFRAY_TEST_OUTPUT_DIR as PREFIX-PRECISION-0.png and PREFIX-PRECISION-diff-1eN.png.
+std::vector<Difference> sweep(const char* label, Layout base, Precision precision, const std::vector<double>& offsets,
+                              const char* picture = nullptr) {
     const Image reference = render(base, precision);
+    const std::string prefix =
+        picture ? std::string(REFRAY_TEST_OUTPUT_DIR) + "/" + picture + "-" + name(precision) + "-" : std::string();
+    if (picture) {
+        std::filesystem::create_directories(REFRAY_TEST_OUTPUT_DIR);
+        writeImage(prefix + "0.png", reference);
+    }
     std::vector<Difference> out;
     for (const double D : offsets) {
         base.offset[0] = D;
         base.offset[1] = D / 2;
         base.offset[2] = -D;
-        const Difference d = compare(reference, render(base, precision));
+        const Image image = render(base, precision);
+        const Difference d = compare(reference, image);
+        if (picture) writeImage(prefix + "diff-" + offsetName(D) + ".png", differenceImage(reference, image));
         std::printf("[translation] %s %s D=%.0e: max |diff| %.4f, pixels > 1/255 %.1f%%, > 0.1 %.1f%%, non-finite %zu; "
                     "object pixels %zu, of them > 1/255 %zu\n",
                     label, name(precision), D, d.maxAbs, 100 * d.shareOver1of255, 100 * d.shareOver0p1, d.nonFinite,
@@ -216,7 +257,8 @@ void expectWithinTheBoundAt1e3(const Difference& d) {
 
 TEST(Translation, GroundAndSpheresStayWithinAPixelFringeAt1e3AndFiniteInDoubleTo1e5) {
     for (const Precision precision : {Precision::Float, Precision::Double}) {
-        const std::vector<Difference> d = sweep("ground+spheres", Layout{}, precision, kOffsets);
+        // Also the pictures of docs/numerical-stability.md (translation-fringe.png).
+        const std::vector<Difference> d = sweep("ground+spheres", Layout{}, precision, kOffsets, "translation");
         expectWithinTheBoundAt1e3(d[0]);
         EXPECT_EQ(d[0].nonFinite, 0u);
         // With float shaders the ground renders NaN from D = 1e4 on (7668 channels at 1e4, 12579 at 1e5, measured):
