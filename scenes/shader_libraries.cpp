@@ -43,8 +43,9 @@ procedural::TraceRayArgumentSet argumentSet(const std::vector<procedural::TraceR
     return set;
 }
 
-template <size_t N>
-std::vector<procedural::TraceRayArguments> perRayType(const std::array<procedural::TraceRayArguments, N>& rayTypes) {
+// A library's per-ray-type constants (an array in its header) as the binding stores them.
+template <class T, size_t N>
+std::vector<T> perRayType(const std::array<T, N>& rayTypes) {
     return {rayTypes.begin(), rayTypes.end()};
 }
 
@@ -60,11 +61,6 @@ std::vector<uint8_t> d3d12Constants(const SceneConstantsInput& in) {
     return bytesOf(cb);
 }
 
-template <size_t N>
-std::vector<uint32_t> rayFlags(const std::array<uint32_t, N>& perRayType) {
-    return {perRayType.begin(), perRayType.end()};
-}
-
 // reference-scene-d3d12-procedural.md §1.7 (ray types), §2.5 (metaballs), §2.9-2.11 (closest hits).
 ShaderLibraryFacts d3d12Facts() {
     namespace d = procedural::d3d12;
@@ -72,7 +68,7 @@ ShaderLibraryFacts d3d12Facts() {
     ShaderLibraryFacts f;
     f.maxRayRecursionDepth = d::MAX_RAY_RECURSION_DEPTH;
     f.shadowRayType = d::RayType::Shadow;
-    f.rayFlags = rayFlags(d::kTraceRayFlags);
+    f.rayFlags = perRayType(d::kTraceRayFlags);
     f.uses = {
         {E::ShadowRays, "MyClosestHitShader_Triangle", "", "", 0.0f},
         {E::ShadowRays, "MyClosestHitShader_AABB", "", "", 0.0f},
@@ -94,7 +90,7 @@ ShaderLibraryFacts procedurayFacts() {
     ShaderLibraryFacts f;
     f.maxRayRecursionDepth = p::MAX_RAY_RECURSION_DEPTH;
     f.shadowRayType = p::Shadow;
-    f.rayFlags = rayFlags(p::kTraceRayFlags);
+    f.rayFlags = perRayType(p::kTraceRayFlags);
     f.uses = {
         {E::ShadowRays, "ClosestHit_Triangle", "", "", 0.0f},
         {E::ShadowRays, "ClosestHit_Pacman", "", "", 0.0f},

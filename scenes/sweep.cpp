@@ -15,6 +15,7 @@
 #include "core/json.h"
 #include "core/json_writer.h"
 #include "core/strings.h"
+#include "core/text_file.h"
 #include "scenes/knobs.h"
 #include "scenes/scene.h"
 #include "scenes/sweep_report.h"
@@ -27,13 +28,6 @@ namespace {
 
 constexpr const char* kPlanFormat = "refray-sweep-plan/1";
 constexpr const char* kRunFormat = "refray-sweep-run/1";
-
-void writeText(const fs::path& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-    out.close();
-    REFRAY_CHECK(out, "cannot write " << path.string());
-}
 
 std::string hostName() {
     char name[256] = {};
@@ -160,7 +154,7 @@ void writeSweepPlan(const fs::path& dir, SweepPlan plan) {
         w.endArray().endObject();
     }
     w.endArray().endObject();
-    writeText(dir / "plan.json", w.text() + "\n");
+    writeTextFile((dir / "plan.json").string(), w.text() + "\n");
 }
 
 SweepPlan readSweepPlan(const fs::path& dir) {
@@ -228,7 +222,7 @@ SweepTiming renderRun(const fs::path& dir, Scene& scene, const SweepPlan& plan, 
     w.member("medianSeconds", timing.medianSeconds).member("threads", timing.threads).member("host", timing.host);
     w.member("warnings", timing.warnings);
     w.endObject();
-    writeText(runJsonPath(dir, id), w.text() + "\n");
+    writeTextFile((runJsonPath(dir, id)).string(), w.text() + "\n");
     return timing;
 }
 
@@ -361,7 +355,7 @@ std::vector<GoldenSearchStep> runGoldenSearch(const fs::path& dir, Progress* pro
             .member("settings", steps[i].settings)
             .endObject();
     w.endArray().endObject();
-    writeText(dir / "golden-search.json", w.text() + "\n");
+    writeTextFile((dir / "golden-search.json").string(), w.text() + "\n");
     return steps;
 }
 
@@ -433,8 +427,8 @@ SweepReport collectSweep(const fs::path& dir) {
     markParetoFronts(report);
     report.goldenSettings = cheapestPassing(report);
     report.plots = writeSweepPlots(dir, report);
-    writeText(dir / "sweep.csv", sweepCsv(report));
-    writeText(dir / "sweep.md", sweepMarkdown(report));
+    writeTextFile((dir / "sweep.csv").string(), sweepCsv(report));
+    writeTextFile((dir / "sweep.md").string(), sweepMarkdown(report));
     return report;
 }
 

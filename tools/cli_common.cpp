@@ -44,15 +44,6 @@ void writeOutput(const std::string& path, const Image& image) {
     writeImage(path, image);
 }
 
-void writeTextFile(const std::string& path, const std::string& text) {
-    const auto parent = std::filesystem::path(path).parent_path();
-    if (!parent.empty()) std::filesystem::create_directories(parent);
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-    out.close();
-    REFRAY_CHECK(out.good(), "cannot write '" << path << "'");
-}
-
 namespace {
 
 std::string base64(const std::string& bytes) {

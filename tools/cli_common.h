@@ -6,6 +6,7 @@
 
 #include "core/image.h"
 #include "core/progress.h"
+#include "core/text_file.h"  // writeTextFile, which the commands use
 
 namespace refray::tools {
 
@@ -21,8 +22,6 @@ void parsePixel(const std::string& text, uint32_t& x, uint32_t& y, const char* o
 Progress::Sink terminalProgress();
 // Writes `image`, creating the parent directory.
 void writeOutput(const std::string& path, const Image& image);
-// Writes `text` to `path`, creating the parent directory; throws refray::Error naming the file.
-void writeTextFile(const std::string& path, const std::string& text);
 
 // The image as a PNG data URI (the bytes an R8G8B8A8_UNORM target holds), for self-contained HTML pages.
 std::string pngDataURI(const Image& image);

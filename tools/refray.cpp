@@ -259,7 +259,7 @@ int runRender(const RenderOptions& o) {
         }
     }
     if (!o.statsJson.empty()) {
-        tools::writeTextFile(o.statsJson, statsJson(result, o.scene, renderedSize, effects));
+        writeTextFile(o.statsJson, statsJson(result, o.scene, renderedSize, effects));
         std::printf("wrote %s\n", o.statsJson.c_str());
     }
     std::printf("wrote %s\n", o.output.c_str());
