@@ -11,6 +11,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "emulator/detail/dispatch_state.h"
 #include "emulator/device.h"
 #include "emulator/embree_bridge.h"
 #include "emulator/limits.h"
@@ -45,18 +46,6 @@ struct StageClock {
 struct ExportCount {
     const ShaderExport* shader = nullptr;
     uint64_t count = 0;
-};
-
-struct DispatchState {
-    Device* device = nullptr;
-    const GpuMemory* memory = nullptr;
-    const StateObject* pipeline = nullptr;
-    const DispatchRaysDesc* desc = nullptr;
-    const GlobalRootArguments* global = nullptr;
-    DispatchOptions options;
-    uint64_t epoch = 0;
-    RecordView rayGenRecord;
-    std::atomic<uint64_t> firstErrorIndex{~0ull};
 };
 
 struct ThreadState {
@@ -977,16 +966,17 @@ void callShader(Invocation& caller, uint32_t shaderIndex, void* parameters, Type
 // ---------------------------------------------------------------------------------------
 // ShaderContext intrinsics.
 
-namespace {
 using detail::Invocation;
 
+namespace detail {
 [[noreturn]] void stageError(Invocation& inv, const char* rule, const std::string& message) {
     detail::ThreadState& ts = *inv.thread;
     Diagnostic d = diag(rule, message).value("stage", toString(inv.stage));
     d.site = DiagnosticSite{ts.launchIndex, inv.depth, inv.stage, inv.shader ? inv.shader->name : std::string()};
     throw DxrError(std::move(d));  // misuse of the API always stops: there is no fallback
 }
-}  // namespace
+}  // namespace detail
+using detail::stageError;
 
 void ShaderContext::stageViolation(const char* intrinsic) const {
     stageError(inv_, "SV-1", std::string(intrinsic) + "() may not be called from a " + std::string(toString(inv_.stage)) +
@@ -1118,38 +1108,6 @@ GpuVirtualAddress ShaderContext::globalRootDescriptor(uint32_t parameter) const 
 }
 
 GpuDescriptorHandle ShaderContext::globalDescriptorTable(uint32_t parameter) const { return globalRootDescriptor(parameter); }
-
-const uint8_t* ShaderContext::readMemory(GpuVirtualAddress address, uint64_t size) const {
-    try {
-        return inv_.dispatch->memory->read(address, size, "shader memory read");
-    } catch (const Error& e) {
-        stageError(inv_, "GEN-1", e.what());
-    }
-}
-
-Image& ShaderContext::rwTexture2D(GpuDescriptorHandle tableHandle, uint32_t offset) const {
-    const DescriptorHeap* heap = inv_.dispatch->device->findDescriptorHeap(tableHandle);
-    if (!heap) stageError(inv_, "GEN-1", "descriptor handle is not in any descriptor heap");
-    const Descriptor& d = heap->at(tableHandle, offset);
-    if (d.kind != Descriptor::Kind::Texture2D || d.type != DescriptorRangeType::UAV)
-        stageError(inv_, "GEN-1", "descriptor " + std::to_string(offset) + " of heap '" + heap->name() +
-                                      "' is not a Texture2D UAV (RWTexture2D)");
-    return *d.texture;
-}
-
-void ShaderContext::readBufferView(GpuDescriptorHandle tableHandle, uint32_t offset, uint64_t byteOffset, uint64_t size,
-                                   void* out) const {
-    const DescriptorHeap* heap = inv_.dispatch->device->findDescriptorHeap(tableHandle);
-    if (!heap) stageError(inv_, "GEN-1", "descriptor handle is not in any descriptor heap");
-    const Descriptor& d = heap->at(tableHandle, offset);
-    if (d.kind != Descriptor::Kind::Buffer)
-        stageError(inv_, "GEN-1", "descriptor " + std::to_string(offset) + " of heap '" + heap->name() +
-                                      "' is not a buffer view");
-    std::memset(out, 0, size);
-    if (byteOffset >= d.buffer.sizeInBytes) return;  // wholly out of range: zeros
-    const uint64_t inRange = std::min(size, d.buffer.sizeInBytes - byteOffset);
-    std::memcpy(out, readMemory(d.buffer.address + byteOffset, inRange), inRange);
-}
 
 // ---------------------------------------------------------------------------------------
 // DispatchRays.
