@@ -34,6 +34,10 @@ struct RenderSettings {
     // fall on a regular grid inside each output pixel, averaged in float (the shaders' own ray generation runs
     // unchanged). 1 is the GPU's image.
     uint32_t spp = 1;
+    // The render's random seed, written into the scene constants (SceneConstantsInput::seed): shaders that sample
+    // at random key their per-pixel generators by it, so renders with other seeds are independent. Libraries
+    // without randomness ignore it.
+    uint32_t seed = 0;
     // Only these pixels of the dispatch run (refray explain); unset: all. Needs spp 1.
     std::optional<dxr::LaunchRegion> region;
     // Receives the trace events of the dispatch (emulator/trace.h); null: nothing is recorded.

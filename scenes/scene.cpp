@@ -199,7 +199,7 @@ Scene::Pipeline& Scene::pipelineFor(const LibraryOptions& options) {
 }
 
 GpuVirtualAddress Scene::generateBuffer(const BufferDesc& b, const CameraDesc& camera, float time, uint32_t width,
-                                        uint32_t height) {
+                                        uint32_t height, uint32_t seed) {
     GpuMemory& memory = device_.memory();
     switch (b.kind) {
         case BufferDesc::Kind::SceneConstants: {
@@ -209,6 +209,7 @@ GpuVirtualAddress Scene::generateBuffer(const BufferDesc& b, const CameraDesc& c
             in.light = desc_.light;
             in.elapsedTime = time;
             in.debugFlag = b.debugFlag;
+            in.seed = seed;
             const std::vector<uint8_t> bytes = findShaderLibrary(desc_.shaderLibrary).sceneConstants(in);
             return memory.upload(bytes, b.name);
         }
@@ -257,7 +258,7 @@ RenderResult Scene::render(const RenderSettings& settings) {
     for (size_t i = 0; i < desc_.buffers.size(); ++i)
         frameAddresses[i] = desc_.buffers[i].kind == BufferDesc::Kind::Data
                                 ? bufferAddresses_[i]
-                                : generateBuffer(desc_.buffers[i], camera, time, width, height);
+                                : generateBuffer(desc_.buffers[i], camera, time, width, height, settings.seed);
 
     GlobalRootArguments globals(globalSignature_);
     uint32_t slot = 0;
@@ -319,6 +320,7 @@ RenderResult Scene::render(const RenderSettings& settings) {
     }
     meta["precision"] = std::string(procedural::toString(settings.precision));
     meta["spp"] = std::to_string(settings.spp);
+    if (settings.seed) meta["seed"] = std::to_string(settings.seed);
     meta["knobs"] = describeKnobs(settings);
     if (desc_.effects.present) meta["effects"] = describeEffectsBlock(desc_.effects);
     meta["size"] = std::to_string(settings.width) + "x" + std::to_string(settings.height);

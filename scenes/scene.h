@@ -46,7 +46,7 @@ private:
     };
     Pipeline& pipelineFor(const LibraryOptions& options);
     dxr::GpuVirtualAddress generateBuffer(const BufferDesc& buffer, const CameraDesc& camera, float time, uint32_t width,
-                                          uint32_t height);
+                                          uint32_t height, uint32_t seed);
 
     SceneDesc desc_;
     dxr::Device device_;

@@ -31,6 +31,7 @@ struct SceneConstantsInput {
     LightDesc light;
     float elapsedTime = 0.0f;
     int32_t debugFlag = 0;
+    uint32_t seed = 0;  // RenderSettings::seed
 };
 
 // What a library's shaders do that the scene's DXR objects do not show, from its fact sheet: the exports that trace
