@@ -55,6 +55,9 @@ struct DispatchStats {
     std::vector<uint64_t> raysPerDepth;  // index = depth of the invoked shaders (1 = primary)
     std::array<uint64_t, 6> invocations{};  // by ShaderStage
     uint64_t candidates = 0;
+    // Rays per traversal mode: every candidate gathered, the nearest sure commit bounding the gather, and
+    // the occlusion query (DispatchOptions::specialise).
+    std::array<uint64_t, 3> raysPerGatherMode{};
 
     // Rays per ray type and depth, sorted by key; a type appears once it traced a ray.
     std::vector<RayTypeCounts> raysPerType;

@@ -511,6 +511,28 @@ bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attrib
 
 namespace {
 
+// FACE-1..3: facing from the object-space winding; the instance transform never flips it.
+bool isFrontFacing(const BuiltGeometry& geom, const Candidate& c, uint32_t instanceFlags) {
+    const vec3* v = &geom.triangleVertices[size_t(c.primitiveIndex) * 3];
+    const dvec3 e1 = dvec3(v[1]) - dvec3(v[0]), e2 = dvec3(v[2]) - dvec3(v[0]);
+    const double facing = glm::dot(glm::cross(e1, e2), dvec3(c.objectRayDirection));
+    bool front = facing < 0.0;
+    if (instanceFlags & INSTANCE_FLAG_TRIANGLE_FRONT_COUNTERCLOCKWISE) front = !front;
+    return front;
+}
+
+// FLAG-10, FACE-5: whether the ray's facing-culling flags drop this triangle.
+bool isFaceCulled(uint32_t rayFlags, uint32_t instanceFlags, bool front) {
+    if (instanceFlags & INSTANCE_FLAG_TRIANGLE_CULL_DISABLE) return false;
+    return ((rayFlags & RAY_FLAG_CULL_BACK_FACING_TRIANGLES) && !front) ||
+           ((rayFlags & RAY_FLAG_CULL_FRONT_FACING_TRIANGLES) && front);
+}
+
+// FLAG-11.
+bool isOpacityCulled(uint32_t rayFlags, bool opaque) {
+    return ((rayFlags & RAY_FLAG_CULL_OPAQUE) && opaque) || ((rayFlags & RAY_FLAG_CULL_NON_OPAQUE) && !opaque);
+}
+
 void processTriangle(ThreadState& ts, RayState& rs, const Candidate& c, const Site& site) {
     if (!(rs.ray.TMin < c.t && c.t < rs.tCurrent)) {  // TRV-2: open interval, current TCurrent
         if (observer(ts)) emitSkipped(ts, rs, "t outside (RayTMin, RayTCurrent) (TRV-2)");
@@ -520,25 +542,15 @@ void processTriangle(ThreadState& ts, RayState& rs, const Candidate& c, const Si
     const BuiltGeometry& geom = inst.blas->geometries()[c.geometryIndex];
     const uint32_t instanceFlags = inst.desc.Flags;
 
-    // FACE-1..3: facing from the object-space winding; the instance transform never flips it.
-    const vec3* v = &geom.triangleVertices[size_t(c.primitiveIndex) * 3];
-    const dvec3 e1 = dvec3(v[1]) - dvec3(v[0]), e2 = dvec3(v[2]) - dvec3(v[0]);
-    const double facing = glm::dot(glm::cross(e1, e2), dvec3(c.objectRayDirection));
-    bool front = facing < 0.0;
-    if (instanceFlags & INSTANCE_FLAG_TRIANGLE_FRONT_COUNTERCLOCKWISE) front = !front;
-
-    if (!(instanceFlags & INSTANCE_FLAG_TRIANGLE_CULL_DISABLE)) {  // FLAG-10, FACE-5
-        if ((rs.effectiveFlags & RAY_FLAG_CULL_BACK_FACING_TRIANGLES) && !front) {
-            if (observer(ts)) emitSkipped(ts, rs, "back face culled: CULL_BACK_FACING_TRIANGLES (FLAG-10)");
-            return;
-        }
-        if ((rs.effectiveFlags & RAY_FLAG_CULL_FRONT_FACING_TRIANGLES) && front) {
-            if (observer(ts)) emitSkipped(ts, rs, "front face culled: CULL_FRONT_FACING_TRIANGLES (FLAG-10)");
-            return;
-        }
+    const bool front = isFrontFacing(geom, c, instanceFlags);
+    if (isFaceCulled(rs.effectiveFlags, instanceFlags, front)) {  // FLAG-10, FACE-5
+        if (observer(ts))
+            emitSkipped(ts, rs, front ? "front face culled: CULL_FRONT_FACING_TRIANGLES (FLAG-10)"
+                                      : "back face culled: CULL_BACK_FACING_TRIANGLES (FLAG-10)");
+        return;
     }
     const bool opaque = isOpaque(geom.flags, instanceFlags, rs.effectiveFlags);
-    if (((rs.effectiveFlags & RAY_FLAG_CULL_OPAQUE) && opaque) || ((rs.effectiveFlags & RAY_FLAG_CULL_NON_OPAQUE) && !opaque)) {
+    if (isOpacityCulled(rs.effectiveFlags, opaque)) {
         if (observer(ts)) emitSkipped(ts, rs, opaque ? "opaque, culled: CULL_OPAQUE (FLAG-11)" : "non-opaque, culled: CULL_NON_OPAQUE (FLAG-11)");
         return;  // FLAG-11
     }
@@ -584,7 +596,7 @@ void processProcedural(ThreadState& ts, RayState& rs, const Candidate& c, const 
     const BuiltInstance& inst = rs.tlas->instances()[c.instanceIndex];
     const BuiltGeometry& geom = inst.blas->geometries()[c.geometryIndex];
     const bool opaque = isOpaque(geom.flags, inst.desc.Flags, rs.effectiveFlags);
-    if (((rs.effectiveFlags & RAY_FLAG_CULL_OPAQUE) && opaque) || ((rs.effectiveFlags & RAY_FLAG_CULL_NON_OPAQUE) && !opaque)) {
+    if (isOpacityCulled(rs.effectiveFlags, opaque)) {
         if (observer(ts)) emitSkipped(ts, rs, opaque ? "opaque, culled: CULL_OPAQUE (FLAG-11)" : "non-opaque, culled: CULL_NON_OPAQUE (FLAG-11)");
         return;  // FLAG-11: before the IS
     }
@@ -625,6 +637,45 @@ void processProcedural(ThreadState& ts, RayState& rs, const Candidate& c, const 
     } catch (const EndSearchSignal&) {
         rs.searchEnded = true;  // IS-6/IS-7/FLAG-8: the IS ended at the accepting ReportHit
     }
+}
+
+// The traversal shortcuts (GatherMode; docs/emulator.md, "Traversal shortcuts").
+struct ShortcutContext {
+    ThreadState* ts;
+    RayState* rs;
+    const Site* site;
+};
+
+// Closest: an in-range triangle the ordered loop commits whenever it reaches it: not culled, and either
+// opaque or in a pipeline without any-hit shaders (then nothing can ignore it).
+bool commitsSurely(const void* user, const Candidate& c) {
+    const auto& sc = *static_cast<const ShortcutContext*>(user);
+    const BuiltInstance& inst = sc.rs->tlas->instances()[c.instanceIndex];
+    const BuiltGeometry& geom = inst.blas->geometries()[c.geometryIndex];
+    const uint32_t flags = sc.rs->effectiveFlags;
+    if (isFaceCulled(flags, inst.desc.Flags, isFrontFacing(geom, c, inst.desc.Flags))) return false;
+    const bool opaque = isOpaque(geom.flags, inst.desc.Flags, flags);
+    if (isOpacityCulled(flags, opaque)) return false;
+    return opaque || !sc.ts->dispatch->anyHitInPipeline;
+}
+
+// FirstHit: the TRV-4 step for one candidate, as Embree meets it.
+bool processNow(void* user, const Candidate& c) {
+    auto& sc = *static_cast<ShortcutContext*>(user);
+    sc.ts->stats.candidates++;
+    if (c.procedural) processProcedural(*sc.ts, *sc.rs, c, *sc.site);
+    else processTriangle(*sc.ts, *sc.rs, c, *sc.site);
+    return sc.rs->searchEnded;
+}
+
+// The shortcut a ray may take: none when it is observed, in adversarial order or with shortcuts off;
+// FirstHit when no order can change its outcome; else Closest.
+GatherMode traversalMode(const ThreadState& ts, const RayState& rs) {
+    const DispatchState& ds = *ts.dispatch;
+    if (!ds.options.specialise || observer(ts) || ds.options.order != TraversalOrder::Ordered) return GatherMode::All;
+    const uint32_t firstHit = RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_SKIP_CLOSEST_HIT_SHADER;
+    if ((rs.effectiveFlags & firstHit) == firstHit && !ds.anyHitInPipeline) return GatherMode::FirstHit;
+    return GatherMode::Closest;
 }
 
 // Orders candidates per DispatchOptions::order (GEN-3).
@@ -859,8 +910,15 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
         gather.skipProcedural = (rs.effectiveFlags & RAY_FLAG_SKIP_PROCEDURAL_PRIMITIVES) != 0;
         gather.alternateEdgeRule = ds.options.order == TraversalOrder::Adversarial && (ds.options.adversarialSeed & 1);
         gather.out = &ts.candidates;
+        ShortcutContext shortcut{&ts, &rs, &site};
+        gather.user = &shortcut;
+        gather.commitsSurely = commitsSurely;
+        gather.onCandidate = processNow;
+        gather.mode = traversalMode(ts, rs);
+        ts.stats.raysPerGatherMode[size_t(gather.mode)]++;
         gatherCandidates(gather);
-        ts.stats.candidates += ts.candidates.size();
+        if (gather.mode != GatherMode::FirstHit) ts.stats.candidates += ts.candidates.size();
+        else ts.candidates.clear();  // processed during the traversal
         orderCandidates(ts, rs);
         // Nested TraceRays (from the CHS below) reuse ts.candidates: iterate over a copy only
         // while shaders of this ray may run, which ends before the CHS starts.
@@ -1193,6 +1251,8 @@ DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObj
     ds.global = globalArguments;
     ds.options = options;
     ds.epoch = epoch_.load();
+    for (const ProgramEntry& entry : pipeline->entries())
+        if (entry.anyHit) ds.anyHitInPipeline = true;
 
     // The ray generation record (IDX-9, IDX-13), resolved once for every thread.
     {

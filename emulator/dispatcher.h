@@ -51,6 +51,11 @@ struct DispatchOptions {
     // Measure the exclusive time of every stage (DispatchStats::stageSeconds) with steady_clock around each
     // shader call and TraceRay. Off: the stage times stay zero and the cost is one untaken branch per site.
     bool profileStages = false;
+    // Traversal shortcuts that change no result, invocation or diagnostic (docs/emulator.md, "Traversal
+    // shortcuts"): Embree's interval shrinks to the nearest triangle sure to commit, and rays that accept the
+    // first hit and skip the closest hit use an occlusion query when the pipeline has no any-hit shader. They
+    // are off for observed rays and adversarial order. false gathers every candidate of every ray.
+    bool specialise = true;
 };
 
 struct DispatchResult {

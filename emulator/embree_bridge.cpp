@@ -64,8 +64,12 @@ namespace {
 struct GatherContext {
     RTCIntersectContext embree;  // must be first
     const GatherRequest* request;
+    float nearestCommit = INFINITY;  // Closest: the smallest t of a triangle sure to commit
     std::exception_ptr error;  // the first exception a callback caught (style rule 9)
 };
+
+// Embree's own intervals are widened a little: the exact tests decide, Embree only culls.
+float widenedFar(float t) { return std::isinf(t) ? t : t + std::fabs(t) * 1e-5f + 1e-30f; }
 
 // Enlarge bounds by a relative margin so Embree's float traversal never culls a box
 // that refray's exact test would touch (BLAS-7 allows conservative boxes).
@@ -106,34 +110,18 @@ void boundsCallback(const RTCBoundsFunctionArguments* args) {
     enlarge(b);
 }
 
-void gatherPrimitive(const RTCIntersectFunctionNArguments* args, const GatherRequest& req);
-
-// Embree swallows exceptions, so the callback catches everything, stops the traversal
-// and leaves the error for gatherCandidates to rethrow once rtcIntersect1 has returned.
-void intersectCallback(const RTCIntersectFunctionNArguments* args) {
-    if (!args->valid[0]) return;
-    auto* ctx = reinterpret_cast<GatherContext*>(args->context);
-    if (ctx->error) return;
-    try {
-        gatherPrimitive(args, *ctx->request);
-    } catch (...) {
-        ctx->error = std::current_exception();
-        RTCRayN_tfar(RTCRayHitN_RayN(args->rayhit, args->N), args->N, 0) = -INFINITY;
-    }
-}
-
-void gatherPrimitive(const RTCIntersectFunctionNArguments* args, const GatherRequest& req) {
-    const auto* user = static_cast<const UserGeometry*>(args->geometryUserPtr);
+// refray's exact test of one primitive Embree reports: the candidate, or nothing if the ray misses it.
+bool exactCandidate(const RTCIntersectContext* context, void* geometryUserPtr, uint32_t prim, const GatherRequest& req,
+                    Candidate& c) {
+    const auto* user = static_cast<const UserGeometry*>(geometryUserPtr);
     const BuiltGeometry& g = *user->geometry;
-    const uint32_t prim = args->primID;
-    if (!g.active[prim]) return;
+    if (!g.active[prim]) return false;
     const bool triangles = g.type == GeometryType::Triangles;
-    if (triangles ? req.skipTriangles : req.skipProcedural) return;
+    if (triangles ? req.skipTriangles : req.skipProcedural) return false;
 
     // refray's own object-space ray (TRV-8): the exact inverse, not Embree's.
-    const uint32_t instanceIndex = args->context->instID[0];
+    const uint32_t instanceIndex = context->instID[0];
     const BuiltInstance& inst = req.tlas->instances()[instanceIndex];
-    Candidate c;
     c.instanceIndex = instanceIndex;
     c.geometryIndex = user->geometryIndex;
     c.primitiveIndex = prim;
@@ -143,20 +131,62 @@ void gatherPrimitive(const RTCIntersectFunctionNArguments* args, const GatherReq
     if (triangles) {
         const vec3* v = &g.triangleVertices[size_t(prim) * 3];
         auto hit = intersectTriangle(c.objectRayOrigin, c.objectRayDirection, v[0], v[1], v[2], req.alternateEdgeRule);
-        if (!hit || !(hit->t >= req.tMin && hit->t <= req.tMax)) return;
+        if (!hit || !(hit->t >= req.tMin && hit->t <= req.tMax)) return false;
         c.t = c.key = hit->t;
         c.barycentrics = hit->barycentrics;
+        c.procedural = false;
     } else {
         auto slab = intersectAABB(c.objectRayOrigin, c.objectRayDirection, g.aabbs[prim], req.tMin, req.tMax);
-        if (!slab) return;
+        if (!slab) return false;
         c.procedural = true;
         c.key = slab->tEnter;
+    }
+    return true;
+}
+
+// All and Closest: collect. Closest also shrinks Embree's tfar to the nearest triangle sure to commit.
+void gatherPrimitive(const RTCIntersectFunctionNArguments* args, GatherContext& ctx) {
+    const GatherRequest& req = *ctx.request;
+    Candidate c;
+    if (!exactCandidate(args->context, args->geometryUserPtr, args->primID, req, c)) return;
+    if (req.mode == GatherMode::Closest) {
+        if (c.key > ctx.nearestCommit) return;  // the ordered loop would skip it (TRV-2)
+        if (!c.procedural && req.tMin < c.t && c.t < req.tMax && req.commitsSurely(req.user, c)) {
+            ctx.nearestCommit = c.t;
+            RTCRayN_tfar(RTCRayHitN_RayN(args->rayhit, args->N), args->N, 0) = widenedFar(c.t);
+        }
     }
     req.out->push_back(c);
 }
 
-void occludedCallback(const RTCOccludedFunctionNArguments*) {
-    // refray always gathers with rtcIntersect1; occlusion queries never reach user geometry.
+// Embree swallows exceptions, so the callbacks catch everything, stop the traversal and leave the error
+// for gatherCandidates to rethrow once Embree has returned.
+void intersectCallback(const RTCIntersectFunctionNArguments* args) {
+    if (!args->valid[0]) return;
+    auto* ctx = reinterpret_cast<GatherContext*>(args->context);
+    if (ctx->error) return;
+    try {
+        gatherPrimitive(args, *ctx);
+    } catch (...) {
+        ctx->error = std::current_exception();
+        RTCRayN_tfar(RTCRayHitN_RayN(args->rayhit, args->N), args->N, 0) = -INFINITY;
+    }
+}
+
+// FirstHit: process each candidate at once; tfar = -inf tells Embree the ray is done.
+void occludedCallback(const RTCOccludedFunctionNArguments* args) {
+    if (!args->valid[0]) return;
+    auto* ctx = reinterpret_cast<GatherContext*>(args->context);
+    if (ctx->error) return;
+    try {
+        const GatherRequest& req = *ctx->request;
+        Candidate c;
+        if (exactCandidate(args->context, args->geometryUserPtr, args->primID, req, c) && req.onCandidate(req.user, c))
+            RTCRayN_tfar(args->ray, args->N, 0) = -INFINITY;
+    } catch (...) {
+        ctx->error = std::current_exception();
+        RTCRayN_tfar(args->ray, args->N, 0) = -INFINITY;
+    }
 }
 
 }  // namespace
@@ -217,25 +247,27 @@ void gatherCandidates(const GatherRequest& request) {
     GatherContext ctx;
     rtcInitIntersectContext(&ctx.embree);
     ctx.request = &request;
+    ctx.error = nullptr;
 
     RTCRayHit rayhit;
-    rayhit.ray.org_x = request.origin.x;
-    rayhit.ray.org_y = request.origin.y;
-    rayhit.ray.org_z = request.origin.z;
-    rayhit.ray.dir_x = request.direction.x;
-    rayhit.ray.dir_y = request.direction.y;
-    rayhit.ray.dir_z = request.direction.z;
-    // Embree's own interval is widened a little: the exact tests decide, Embree only culls.
-    rayhit.ray.tnear = std::max(0.0f, request.tMin - (std::fabs(request.tMin) * 1e-5f + 1e-30f));
-    rayhit.ray.tfar = std::isinf(request.tMax) ? request.tMax : request.tMax + std::fabs(request.tMax) * 1e-5f + 1e-30f;
-    rayhit.ray.time = 0.0f;
-    rayhit.ray.mask = request.instanceInclusionMask & 0xFF;
-    rayhit.ray.id = 0;
-    rayhit.ray.flags = 0;
+    RTCRay& ray = rayhit.ray;
+    ray.org_x = request.origin.x;
+    ray.org_y = request.origin.y;
+    ray.org_z = request.origin.z;
+    ray.dir_x = request.direction.x;
+    ray.dir_y = request.direction.y;
+    ray.dir_z = request.direction.z;
+    ray.tnear = std::max(0.0f, request.tMin - (std::fabs(request.tMin) * 1e-5f + 1e-30f));
+    ray.tfar = widenedFar(request.tMax);
+    ray.time = 0.0f;
+    ray.mask = request.instanceInclusionMask & 0xFF;
+    ray.id = 0;
+    ray.flags = 0;
     rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    ctx.error = nullptr;
-    rtcIntersect1(static_cast<RTCScene>(request.tlas->embree().scene), &ctx.embree, &rayhit);
+    RTCScene scene = static_cast<RTCScene>(request.tlas->embree().scene);
+    if (request.mode == GatherMode::FirstHit) rtcOccluded1(scene, &ctx.embree, &ray);
+    else rtcIntersect1(scene, &ctx.embree, &rayhit);
     if (ctx.error) std::rethrow_exception(ctx.error);
 }
 

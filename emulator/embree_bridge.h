@@ -53,6 +53,22 @@ struct Candidate {
     vec3 objectRayDirection{0.0f};
 };
 
+// How the broad phase hands candidates over (DispatchOptions::specialise; docs/emulator.md, "Traversal
+// shortcuts").
+enum class GatherMode : uint8_t {
+    // Every candidate in [tMin, tMax], for the dispatcher to order and process: observed rays, adversarial
+    // order, or shortcuts switched off.
+    All,
+    // As All, but a triangle that is sure to commit when the ordered loop reaches it (`commitsSurely`)
+    // shrinks Embree's interval to its t, and candidates starting beyond the nearest such t are dropped: the
+    // ordered loop would skip them (TRV-2), so no result, invocation or diagnostic changes.
+    Closest,
+    // rtcOccluded1: each candidate goes to `onCandidate` as Embree meets it, and traversal stops once that
+    // returns true. For rays whose outcome cannot depend on the order (ACCEPT_FIRST_HIT_AND_END_SEARCH with
+    // SKIP_CLOSEST_HIT_SHADER, and no any-hit shader in the pipeline).
+    FirstHit,
+};
+
 struct GatherRequest {
     const TopLevelAS* tlas = nullptr;
     vec3 origin{0.0f};
@@ -63,12 +79,18 @@ struct GatherRequest {
     bool skipTriangles = false;
     bool skipProcedural = false;
     bool alternateEdgeRule = false;
-    std::vector<Candidate>* out = nullptr;
+    GatherMode mode = GatherMode::All;
+    // Closest: true if the ordered loop would commit this in-range triangle candidate whenever it reaches it.
+    bool (*commitsSurely)(const void* user, const Candidate& c) = nullptr;
+    // FirstHit: processes one candidate; returns true when the search has ended.
+    bool (*onCandidate)(void* user, const Candidate& c) = nullptr;
+    void* user = nullptr;
+    std::vector<Candidate>* out = nullptr;  // All, Closest
 };
 
-// Appends every primitive of an active, unmasked instance that truly overlaps
-// [tMin, tMax] (triangles: the exact hit at tMin <= t <= tMax; AABBs: the box touches
-// the interval, inclusive). Throws refray::Error if Embree reported an error.
+// Hands every primitive of an active, unmasked instance that truly overlaps [tMin, tMax] (triangles: the
+// exact hit at tMin <= t <= tMax; AABBs: the box touches the interval, inclusive) to the request, as its
+// mode says. Throws refray::Error if Embree reported an error, and rethrows what a callback threw.
 void gatherCandidates(const GatherRequest& request);
 
 }  // namespace refray::dxr::detail

@@ -44,6 +44,8 @@ struct RenderSettings {
     dxr::TraceObserver* observer = nullptr;
     // Time each shader stage and the traversal (DispatchStats::stageSeconds); costs a few per cent when on.
     bool profileStages = false;
+    // DispatchOptions::specialise: traversal shortcuts that change no result.
+    bool specialise = true;
 };
 
 // Runs DispatchRays for a width x height dispatch with the settings' threads, order, error mode and progress.
@@ -58,6 +60,7 @@ inline dxr::DispatchResult dispatchWithSettings(dxr::Device& device, const dxr::
     options.region = settings.region;
     options.observer = settings.observer;
     options.profileStages = settings.profileStages;
+    options.specialise = settings.specialise;
     std::unique_ptr<Progress> progress;
     if (settings.progress) {
         const uint64_t launches = settings.region ? uint64_t(settings.region->width) * settings.region->height * desc.Depth

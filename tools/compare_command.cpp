@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/statistical_compare.h"
 #include "core/strings.h"
 #include "tools/cli_common.h"
 
@@ -31,6 +32,13 @@ override the profile.
 REFERENCE may have platform variants beside it (ref.png, ref-<anything>.png): the
 candidate passes if it matches any; the report names the match, or the best one.
 
+Noisy (Monte Carlo) renders: make statistics images (mean and variance of K independent
+renders) with 'refray render SCENE --batches K -o ref.exr', then
+  refray compare --statistical ref.exr test.exr [--alpha 0.01] [--correction sidak] [--map map.png]
+runs Welch's t-test per pixel and channel; the image fails when any p-value is below
+alpha corrected for the number of tests, so alpha is the false-alarm probability for the
+whole image.
+
 Exit status: 0 pass, 1 warning, 2 failure, 3 size mismatch, 4 file error.
 See docs/compare.md.)";
 
@@ -45,6 +53,29 @@ CLI::Validator numberAtLeastZero(bool positive) {
             return {};
         },
         "");
+}
+
+// A number strictly between 0 and 1.
+CLI::Validator openUnitInterval() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            char* end = nullptr;
+            const double value = std::strtod(text.c_str(), &end);
+            if (text.empty() || *end != '\0' || !(value > 0.0 && value < 1.0))
+                return "expects a number between 0 and 1 (exclusive), got '" + text + "'";
+            return {};
+        },
+        "");
+}
+
+bool readStatisticsInto(const std::string& path, StatisticsImage& stats) {
+    try {
+        stats = readStatisticsImage(path);
+        return true;
+    } catch (const Error& e) {
+        std::fprintf(stderr, "refray compare --statistical: %s\n", e.what());
+        return false;
+    }
 }
 
 bool readInto(const std::string& path, Image& image) {
@@ -145,11 +176,45 @@ CLI::App* addCompareCommand(CLI::App& app, CompareCommandOptions& o) {
         ->check(CLI::IsMember({"flip", "abs"}));
     sub->add_option("--diff-scale", o.diffScale, "Scale of --diff-mode abs")->check(numberAtLeastZero(true))->capture_default_str();
     sub->add_option("--html", o.htmlPath, "Write a self-contained HTML report");
-    sub->add_option("--ppd", o.pixelsPerDegree, "FLIP's pixels per degree of visual angle")
-        ->check(numberAtLeastZero(true))->capture_default_str();
+    CLI::Option* ppd = sub->add_option("--ppd", o.pixelsPerDegree, "FLIP's pixels per degree of visual angle")
+                           ->check(numberAtLeastZero(true))->capture_default_str();
+
+    sub->add_flag("--statistical", o.statistical,
+                  "REFERENCE and CANDIDATE are statistics images of noisy renders (mean and variance, from "
+                  "'refray render --batches K'): a Welch t-test per pixel and channel");
+    CLI::Option* alpha = sub->add_option("--alpha", o.alpha,
+                                         "--statistical: the probability of a false alarm for the whole image")
+                             ->check(openUnitInterval())->capture_default_str();
+    CLI::Option* correction =
+        sub->add_option("--correction", o.correction,
+                        "--statistical: the multiple-comparison correction, sidak (default) or bonferroni")
+            ->check(CLI::IsMember({"sidak", "bonferroni"}));
+    CLI::Option* map = sub->add_option("--map", o.mapPath,
+                                       "--statistical: write the failure map (PNG): red where a pixel fails, magenta "
+                                       "for NaN or infinity, grey rising with -log10 p elsewhere");
+
+    // Each kind of comparison refuses the other's options, so that none is silently ignored.
+    const std::vector<CLI::Option*> thresholdOnly = {
+        fail, failPercent, hardFail, warn, warnPercent, hardWarn, sub->get_option("--golden"),
+        sub->get_option("--channels"), sub->get_option("--mask"), sub->get_option("--diff"),
+        sub->get_option("--diff-mode"), sub->get_option("--diff-scale"), sub->get_option("--html"), ppd};
+    const std::vector<CLI::Option*> statisticalOnly = {alpha, correction, map};
 
     // --golden gives the defaults; thresholds given on the command line win.
-    sub->callback([&o, fail, failPercent, hardFail, warn, warnPercent, hardWarn] {
+    sub->callback([&o, fail, failPercent, hardFail, warn, warnPercent, hardWarn, thresholdOnly, statisticalOnly] {
+        const auto given = [](const std::vector<CLI::Option*>& options) {
+            std::string names;
+            for (const CLI::Option* option : options)
+                if (option->count()) names += (names.empty() ? "" : ", ") + option->get_name();
+            return names;
+        };
+        if (o.statistical && !given(thresholdOnly).empty())
+            throw CLI::ValidationError("--statistical", "cannot be combined with " + given(thresholdOnly) +
+                                                            " (options of the threshold comparison); a statistical "
+                                                            "comparison takes --alpha, --correction and --map");
+        if (!o.statistical && !given(statisticalOnly).empty())
+            throw CLI::ValidationError(given(statisticalOnly), "needs --statistical (REFERENCE and CANDIDATE being "
+                                                               "statistics images from 'refray render --batches K')");
         if (!o.golden) return;
         const CompareThresholds g = CompareThresholds::golden();
         if (!fail->count()) o.thresholds.fail = g.fail;
@@ -162,7 +227,50 @@ CLI::App* addCompareCommand(CLI::App& app, CompareCommandOptions& o) {
     return sub;
 }
 
+namespace {
+
+int runStatisticalCompare(const CompareCommandOptions& o) {
+    try {
+        StatisticsImage reference, candidate;
+        if (!readStatisticsInto(o.reference, reference)) return 4;
+        if (!readStatisticsInto(o.candidate, candidate)) return 4;
+        StatisticalCompareOptions options;
+        options.alpha = o.alpha;
+        options.correction =
+            o.correction == "bonferroni" ? MultipleComparisonCorrection::Bonferroni : MultipleComparisonCorrection::Sidak;
+        const StatisticalCompareResult result = compareStatistics(reference, candidate, options);
+
+        std::printf("Comparing \"%s\" against \"%s\" statistically (Welch's t-test per pixel and channel)\n",
+                    o.candidate.c_str(), o.reference.c_str());
+        std::fputs(result.describe().c_str(), stdout);
+        std::fflush(stdout);
+
+        int status = int(result.verdict);
+        if (!o.mapPath.empty()) {
+            try {
+                if (result.failureMap.empty()) {
+                    std::fprintf(stderr, "refray compare: no failure map written: %s\n", result.mismatch.c_str());
+                } else {
+                    createParentDirectory(o.mapPath);
+                    writeImage(o.mapPath, result.failureMap);
+                    std::printf("wrote %s\n", o.mapPath.c_str());
+                }
+            } catch (const Error& e) {
+                std::fprintf(stderr, "refray compare: %s\n", e.what());
+                status = 4;
+            }
+        }
+        return status;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "refray compare --statistical: %s\n", e.what());
+        return 4;
+    }
+}
+
+}  // namespace
+
 int runCompare(const CompareCommandOptions& o) {
+    if (o.statistical) return runStatisticalCompare(o);
     try {
         // Inputs: any unreadable file is exit 4, named.
         Image candidate, mask;

@@ -1,6 +1,7 @@
 // `refray compare REFERENCE CANDIDATE`: a render against a golden image, with idiff's
 // verdicts and exit codes, FLIP, a diff heat map and a self-contained HTML report.
-// docs/compare.md is the user's guide.
+// `refray compare --statistical REF.exr TEST.exr`: two statistics images of noisy renders
+// (core/statistical_compare.h) by a per-pixel Welch t-test. docs/compare.md is the user's guide.
 //
 // Wiring into the main program (tools/refray.cpp):
 //     refray::tools::CompareCommandOptions compareOptions;
@@ -30,6 +31,12 @@ struct CompareCommandOptions {
     double pixelsPerDegree = kFlipDefaultPixelsPerDegree;
     bool golden = false;
     CompareThresholds thresholds;
+
+    // --statistical: REFERENCE and CANDIDATE are statistics images (mean and variance).
+    bool statistical = false;
+    double alpha = 0.01;                // --alpha: false-alarm probability for the whole image
+    std::string correction = "sidak";   // --correction: "sidak" or "bonferroni"
+    std::string mapPath;                // --map: the failure map (PNG)
 };
 
 // Adds the `compare` subcommand to `app`; app.parse() fills `options`, which must
@@ -38,7 +45,8 @@ CLI::App* addCompareCommand(CLI::App& app, CompareCommandOptions& options);
 
 // Runs the comparison: the report goes to stdout, errors to stderr. Returns idiff's
 // exit code: 0 pass, 1 warning, 2 failure, 3 size mismatch, 4 file error (a file that
-// cannot be read or written; the message names it). Throws nothing.
+// cannot be read or written, or with --statistical one that is no statistics image; the
+// message names it). Throws nothing.
 int runCompare(const CompareCommandOptions& options);
 
 // One row of an HTML report: the images shown and the comparison's result. The

@@ -1,7 +1,10 @@
 // refray: the command line. Only this layer prints and exits.
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -14,6 +17,7 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "core/json_writer.h"
+#include "core/statistical_compare.h"
 #include "core/strings.h"
 #include "emulator/validation.h"
 #include "procedural/precision.h"
@@ -68,6 +72,9 @@ void printStats(const scenes::RenderResult& r, const Size& size) {
     for (const dxr::ExportInvocations& e : st.invocationsPerExport)
         std::printf("    %-13s %s: %llu\n", std::string(dxr::toString(e.stage)).c_str(), e.exportName.c_str(), u(e.count));
     std::printf("  candidates gathered: %llu\n", u(st.candidates));
+    std::printf("  rays per traversal mode: %llu every candidate, %llu bounded by the nearest sure commit, %llu "
+                "occlusion query\n",
+                u(st.raysPerGatherMode[0]), u(st.raysPerGatherMode[1]), u(st.raysPerGatherMode[2]));
 
     // Exclusive time per stage.
     const double total = st.profiledSeconds();
@@ -102,6 +109,12 @@ std::string statsJson(const scenes::RenderResult& r, const std::string& scene, c
     w.member("wallSeconds", r.dispatch.seconds).member("raysTraced", st.raysTraced);
     w.member("raysPerSecond", r.dispatch.seconds > 0 ? double(st.raysTraced) / r.dispatch.seconds : 0.0);
     w.member("candidates", st.candidates);
+    w.key("raysPerTraversalMode")
+        .beginObject(json::Writer::Layout::Inline)
+        .member("all", st.raysPerGatherMode[0])
+        .member("closest", st.raysPerGatherMode[1])
+        .member("firstHit", st.raysPerGatherMode[2])
+        .endObject();
     w.key("raysPerDepth");
     perDepth(st.raysPerDepth);
     w.key("rayTypes").beginArray();
@@ -154,8 +167,10 @@ struct RenderOptions {
     uint32_t threads = 0;
     bool stats = false;
     std::string statsJson;  // --stats-json FILE
+    bool noShortcuts = false;  // --no-shortcuts: DispatchOptions::specialise off
     std::string order = "ordered";
-    uint64_t seed = 0;
+    uint64_t seed = 0;  // RenderSettings::seed (the first batch's) and the adversarial order's seed
+    std::optional<uint32_t> batches;  // --batches K: a statistics image of K renders
     std::string camera;
     std::optional<float> time;
     std::string precision = "float";
@@ -187,10 +202,54 @@ void renderIndexMap(scenes::Scene& scene, const scenes::RenderSettings& settings
 }
 
 
+bool endsWithExr(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext == ".exr";
+}
+
+// --batches K: renders K times with seeds S, S+1, ..., S+K-1 (a line per batch) and returns their statistics; `last`
+// receives the last batch's render (for --stats).
+StatisticsImage renderBatches(const std::function<scenes::RenderResult(const scenes::RenderSettings&)>& renderOnce,
+                              scenes::RenderSettings settings, uint32_t batches, scenes::RenderResult& last) {
+    StatisticsAccumulator accumulator;
+    const uint32_t firstSeed = settings.seed;
+    double seconds = 0.0;
+    for (uint32_t k = 0; k < batches; ++k) {
+        settings.seed = firstSeed + k;
+        last = renderOnce(settings);
+        accumulator.add(last.image);
+        seconds += last.dispatch.seconds;
+        std::printf("batch %u/%u (seed %u): %.3f s\n", k + 1, batches, settings.seed, last.dispatch.seconds);
+        std::fflush(stdout);
+    }
+    StatisticsImage stats = accumulator.finish();
+    stats.mean.metadata["seed"] = std::to_string(firstSeed);
+    stats.mean.metadata["statistics_seeds"] = std::to_string(firstSeed) + ".." + std::to_string(firstSeed + batches - 1);
+    stats.mean.metadata["render_seconds"] = std::to_string(seconds);
+    return stats;
+}
+
 int runRender(const RenderOptions& o) {
     scenes::RenderSettings settings;
     settings.threads = o.threads;
     settings.adversarialSeed = o.seed;
+    const uint32_t batches = o.batches.value_or(1);
+    REFRAY_CHECK(!o.batches || *o.batches >= 2, "--batches needs at least 2 renders to estimate a variance, got "
+                                                    << *o.batches);
+    REFRAY_CHECK(o.seed <= 0xFFFFFFFFull - (batches - 1),
+                 "--seed takes 0 .. 4294967295" << (o.batches ? " (less the batches after the first)" : "") << ", got "
+                                                << o.seed);
+    settings.seed = uint32_t(o.seed);
+    if (o.batches) {
+        REFRAY_CHECK(endsWithExr(o.output), "--batches writes a statistics image (the mean and variance of "
+                                                << *o.batches << " renders), which needs OpenEXR: give -o a name "
+                                                                 "ending in .exr, got '"
+                                                << o.output << "'");
+        REFRAY_CHECK(o.aov.empty() && o.orderCheck == 0,
+                     "--batches renders the image K times for its statistics; --aov and --order-check are separate "
+                     "renders: give them without --batches");
+    }
     REFRAY_CHECK(o.order == "ordered" || o.order == "adversarial",
                  "--order expects 'ordered' or 'adversarial', got '" << o.order << "'");
     settings.order = o.order == "adversarial" ? dxr::TraversalOrder::Adversarial : dxr::TraversalOrder::Ordered;
@@ -203,8 +262,10 @@ int runRender(const RenderOptions& o) {
     settings.spp = o.spp;
     for (const std::string& k : o.knobs) scenes::applyKnobAssignment(settings, k);
     settings.profileStages = o.stats || !o.statsJson.empty();
+    settings.specialise = !o.noShortcuts;
 
     scenes::RenderResult result;
+    std::optional<StatisticsImage> statistics;  // --batches
     scenes::EffectSet effectSet;
     std::vector<scenes::Effect> effects;  // of a scene file (the built-in scene has none to report)
     if (o.scene == "builtin") {
@@ -215,10 +276,15 @@ int runRender(const RenderOptions& o) {
         const Size size = parseSize(o.size.empty() ? "640x360" : o.size);
         settings.width = size.width, settings.height = size.height;
         scenes::BuiltinScene scene;
-        result = scene.render(settings);
-        result.image.metadata["scene"] = "builtin";
-        result.image.metadata["size"] = std::to_string(size.width) + "x" + std::to_string(size.height);
-        result.image.metadata["traversal_order"] = o.order;
+        const auto renderOnce = [&](const scenes::RenderSettings& s) {
+            scenes::RenderResult r = scene.render(s);
+            r.image.metadata["scene"] = "builtin";
+            r.image.metadata["size"] = std::to_string(size.width) + "x" + std::to_string(size.height);
+            r.image.metadata["traversal_order"] = o.order;
+            return r;
+        };
+        if (o.batches) statistics = renderBatches(renderOnce, settings, batches, result);
+        else result = renderOnce(settings);
     } else {
         std::unique_ptr<scenes::Scene> scene = scenes::loadScene(o.scene);
         effectSet = scenes::computeEffects(scene->desc(), settings);
@@ -239,18 +305,37 @@ int runRender(const RenderOptions& o) {
                         "orders); mask: %s\n",
                         (unsigned long long)check.orderDependentPixels, size.width * size.height, o.orderCheck,
                         mask.c_str());
+        } else if (o.batches) {
+            statistics = renderBatches([&](const scenes::RenderSettings& s) { return scene->render(s); }, settings,
+                                       batches, result);
         } else {
             result = scene->render(settings);
         }
     }
     for (const auto& w : result.dispatch.diagnostics.warnings()) std::fprintf(stderr, "%s\n", w.format().c_str());
-    result.image.metadata["refray_version"] = tools::kVersion;
-    result.image.metadata["refray_commit"] = tools::kCommit;
-    result.image.metadata["threads"] = std::to_string(o.threads);
-    result.image.metadata["render_seconds"] = std::to_string(result.dispatch.seconds);
-    writeOutput(o.output, result.image);
+    if (statistics) {
+        statistics->mean.metadata["refray_version"] = tools::kVersion;
+        statistics->mean.metadata["refray_commit"] = tools::kCommit;
+        statistics->mean.metadata["threads"] = std::to_string(o.threads);
+        const auto parent = std::filesystem::path(o.output).parent_path();
+        if (!parent.empty()) std::filesystem::create_directories(parent);
+        writeStatisticsImage(o.output, *statistics);
+        const bool noVariance = std::all_of(statistics->varianceOfMean.begin(), statistics->varianceOfMean.end(),
+                                            [](const vec3& v) { return v == vec3(0.0f); });
+        if (noVariance)
+            std::printf("note: the %u batches are identical (the scene samples nothing at random), so the variance is "
+                        "0 everywhere: a statistical comparison against this file is an exact one\n",
+                        statistics->batches);
+    } else {
+        result.image.metadata["refray_version"] = tools::kVersion;
+        result.image.metadata["refray_commit"] = tools::kCommit;
+        result.image.metadata["threads"] = std::to_string(o.threads);
+        result.image.metadata["render_seconds"] = std::to_string(result.dispatch.seconds);
+        writeOutput(o.output, result.image);
+    }
     const Size renderedSize{result.image.width(), result.image.height()};
     if (o.stats) {
+        if (statistics) std::printf("stats of the last batch (seed %u):\n", settings.seed + batches - 1);
         printStats(result, renderedSize);
         if (!effects.empty()) {
             std::printf("  effects:\n");
@@ -294,10 +379,19 @@ int main(int argc, char** argv) {
                        "(see 'refray sweep --help')");
     render->add_option("--threads", ro.threads, "Worker threads (0: all)")->capture_default_str();
     render->add_option("--order", ro.order, "Traversal order: ordered (default) or adversarial (GEN-3)");
-    render->add_option("--seed", ro.seed, "Seed of the adversarial order");
+    render->add_option("--seed", ro.seed,
+                       "Random seed: RenderSettings::seed, for shaders that sample at random (the first batch's with "
+                       "--batches), and the seed of the adversarial order")
+        ->capture_default_str();
+    render->add_option("--batches", ro.batches,
+                       "Render K >= 2 times with seeds S, S+1, ..., S+K-1 and write a statistics image (-o FILE.exr: "
+                       "the mean and the variance of the mean) for 'refray compare --statistical'");
     render->add_flag("--stats", ro.stats,
                      "Print rays per ray type and depth, invocations per export, and the exclusive time per stage");
     render->add_option("--stats-json", ro.statsJson, "Write the --stats measures to FILE as JSON (format refray-stats/1)");
+    render->add_flag("--no-shortcuts", ro.noShortcuts,
+                     "Gather every candidate of every ray: no traversal shortcuts (for measuring them; the image is "
+                     "the same)");
     render->add_option("--aov", ro.aov,
                        "Write an index map instead of the render: record|instance|geometry|primitive|hitgroup|depth "
                        "of each pixel's primary ray, false-coloured, with a legend");

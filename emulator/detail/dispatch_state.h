@@ -20,6 +20,7 @@ struct DispatchState {
     DispatchOptions options;
     uint64_t epoch = 0;
     RecordView rayGenRecord;
+    bool anyHitInPipeline = false;  // a hit group of the pipeline names an any-hit shader
     std::atomic<uint64_t> firstErrorIndex{~0ull};
 };
 

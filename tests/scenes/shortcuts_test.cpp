@@ -1,0 +1,52 @@
+// The traversal shortcuts on the reference scenes (DispatchOptions::specialise): the same image, bit for bit,
+// and the same ray-generation, closest-hit and miss invocations as gathering every candidate; shadow rays take the occlusion
+// query (neither library has an any-hit shader), every other ray the bounded gather.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+
+#include "scenes/scene.h"
+#include "scenes/scene_loader.h"
+
+namespace refray::scenes {
+namespace {
+
+const std::string kSourceDir = REFRAY_SOURCE_DIR;
+
+void expectSameRender(const std::string& file, uint32_t shadowMissIndex) {
+    SCOPED_TRACE(file);
+    Scene scene(loadSceneFile(kSourceDir + "/scenes/" + file));
+    RenderSettings settings;
+    settings.width = 48;
+    settings.height = 27;
+    settings.specialise = false;
+    const RenderResult all = scene.render(settings);
+    settings.specialise = true;
+    const RenderResult fast = scene.render(settings);
+
+    ASSERT_EQ(all.image.pixels().size(), fast.image.pixels().size());
+    EXPECT_EQ(std::memcmp(all.image.pixels().data(), fast.image.pixels().data(), all.image.pixels().size() * sizeof(vec4)), 0);
+    const dxr::DispatchStats& a = all.dispatch.stats;
+    const dxr::DispatchStats& f = fast.dispatch.stats;
+    EXPECT_EQ(a.raysTraced, f.raysTraced);
+    for (dxr::ShaderStage stage : {dxr::ShaderStage::RayGeneration, dxr::ShaderStage::ClosestHit, dxr::ShaderStage::Miss})
+        EXPECT_EQ(a.invocationsOf(stage), f.invocationsOf(stage)) << dxr::toString(stage);
+    // Intersection shaders may run more or less often: the occlusion query meets boxes in Embree's order.
+    EXPECT_LT(f.candidates, a.candidates);
+
+    EXPECT_EQ(a.raysPerGatherMode[0], a.raysTraced);
+    uint64_t shadowRays = 0;
+    for (const dxr::RayTypeCounts& t : f.raysPerType)
+        if (t.key.missShaderIndex == shadowMissIndex) shadowRays += t.total();
+    EXPECT_GT(shadowRays, 0u);
+    EXPECT_EQ(f.raysPerGatherMode[2], shadowRays);
+    EXPECT_EQ(f.raysPerGatherMode[1], f.raysTraced - shadowRays);
+}
+
+TEST(TraversalShortcutsScenes, D3D12RendersTheSameImage) { expectSameRender("d3d12-procedural-geometry.json", 1); }
+
+TEST(TraversalShortcutsScenes, ProcedurayRendersTheSameImage) { expectSameRender("proceduray-mandel-julia-pac.json", 1); }
+
+}  // namespace
+}  // namespace refray::scenes
