@@ -11,6 +11,7 @@
 
 #include <array>
 #include <cstring>
+#include <type_traits>
 
 #include "core/image.h"
 #include "emulator/descriptor_heap.h"
@@ -20,7 +21,50 @@ namespace refray::dxr {
 
 namespace detail {
 constexpr uint8_t stageBit(ShaderStage s) { return uint8_t(1u << uint8_t(s)); }
+struct BoundResource;  // shader_resources.cpp
 }  // namespace detail
+
+class ShaderContext;
+
+// HLSL SamplerState: a sampler resolved from an s register by ShaderContext::SamplerState. Valid for the dispatch
+// that resolved it.
+class SamplerRef {
+public:
+    const SamplerDesc& desc() const { return *desc_; }
+
+private:
+    friend class ShaderContext;
+    explicit SamplerRef(const SamplerDesc* desc) : desc_(desc) {}
+    const SamplerDesc* desc_;
+};
+
+// HLSL Texture2D<float4>: a texture resolved from a t register by ShaderContext::Texture2D. Valid for the dispatch
+// that resolved it. Ray-tracing shaders have no implicit derivatives, so there is no Sample(): use SampleLevel,
+// SampleGrad or Load (filtering rules: texture.h). A null descriptor reads (0, 0, 0, 0) and has dimensions 0.
+// A texture file that can no longer be read stops the dispatch with BIND-6.
+class Texture2DRef {
+public:
+    vec4 SampleLevel(SamplerRef S, vec2 Location, float LOD) const;
+    vec4 SampleGrad(SamplerRef S, vec2 Location, vec2 DDX, vec2 DDY) const;
+    // Location = (x, y, MIP level); out of range reads (0, 0, 0, 0).
+    vec4 Load(glm::ivec3 Location) const;
+    // Width and Height of MipLevel (0 past the last level) and the number of levels.
+    void GetDimensions(uint32_t MipLevel, uint32_t& Width, uint32_t& Height, uint32_t& NumberOfLevels) const;
+    void GetDimensions(uint32_t& Width, uint32_t& Height) const;
+
+    bool isNull() const { return texture_ == nullptr; }
+    const dxr::Texture2D* texture() const { return texture_; }
+
+private:
+    friend class ShaderContext;
+    Texture2DRef(const ShaderContext& ctx, const dxr::Texture2D* texture, uint32_t shaderRegister, uint32_t space,
+                 uint32_t arrayIndex)
+        : ctx_(&ctx), texture_(texture), register_(shaderRegister), space_(space), index_(arrayIndex) {}
+    [[noreturn]] void readFailed(const char* method, const std::string& why) const;
+    const ShaderContext* ctx_;
+    const dxr::Texture2D* texture_;
+    uint32_t register_, space_, index_;
+};
 
 class ShaderContext {
 public:
@@ -127,6 +171,53 @@ public:
         return value;
     }
 
+    // --- Resources by HLSL register and space, every stage (BIND-1..BIND-6, docs/emulator.md "Resource binding
+    // (BIND)"). Resolved through the global root signature bound to the dispatch, then the local root signature of
+    // the executing shader's record (PIPE-7 keeps them apart): the root parameter, table range or static sampler
+    // that binds the register (RootSignature::findRegister), then for a table the descriptor at table handle +
+    // range offset + (register - range base) + arrayIndex in its heap. Root arguments read here are checked like
+    // globalRootDescriptor/localRootDescriptor (REC-7 for unwritten bytes). An HLSL array
+    // `T name[] : register(tN, spaceM)` is (N, M, i) for name[i]; element i must lie in the binding that covers
+    // register N. Every failure stops the dispatch with a DxrError naming the register, space, index, the root
+    // signature and what was found; a null descriptor (written as one) reads zeros, a never-written one is BIND-4.
+
+    // `Texture2D<float4> name[] : register(t<shaderRegister>, space<space>)`, element arrayIndex: a Texture2D SRV
+    // in a descriptor table (BIND-3 for anything else).
+    Texture2DRef Texture2D(uint32_t shaderRegister, uint32_t space, uint32_t arrayIndex = 0) const;
+    // `SamplerState name : register(s<shaderRegister>, space<space>)`: a static sampler of either root signature or
+    // a sampler in a sampler table (a Sampler heap).
+    SamplerRef SamplerState(uint32_t shaderRegister, uint32_t space = 0, uint32_t arrayIndex = 0) const;
+    // `StructuredBuffer<T> name[] : register(t<shaderRegister>, space<space>)`, name[arrayIndex][elementIndex].
+    // In a table, sizeof(T) must equal the view's StructureByteStride (BIND-5) and an element past the view reads
+    // zeros, as D3D defines. A root SRV has no view: it reads address + elementIndex * sizeof(T) (GEN-1 outside
+    // GPU memory).
+    template <class T>
+    T loadStructured(uint32_t shaderRegister, uint32_t space, uint32_t arrayIndex, uint64_t elementIndex) const {
+        static_assert(std::is_trivially_copyable_v<T>, "structured buffer elements are plain bytes");
+        T value;
+        readStructured(shaderRegister, space, arrayIndex, elementIndex, sizeof(T), &value);
+        return value;
+    }
+    // `ByteAddressBuffer name[] : register(t<shaderRegister>, space<space>)`, name[arrayIndex].Load<T>(byteOffset).
+    // byteOffset must be a multiple of 4 and a table view must be raw (StructureByteStride 0) (BIND-5); bytes past
+    // the view read zeros.
+    template <class T>
+    T loadByteAddress(uint32_t shaderRegister, uint32_t space, uint32_t arrayIndex, uint64_t byteOffset) const {
+        static_assert(std::is_trivially_copyable_v<T>, "ByteAddressBuffer loads are plain bytes");
+        T value;
+        readByteAddress(shaderRegister, space, arrayIndex, byteOffset, sizeof(T), &value);
+        return value;
+    }
+    // `ConstantBuffer<T> name : register(b<shaderRegister>, space<space>)`: root constants (at least sizeof(T)
+    // bytes of them, BIND-5; REC-7 if unwritten), a root CBV, or a CBV in a table (bytes past the view read zeros).
+    template <class T>
+    T constantBuffer(uint32_t shaderRegister, uint32_t space = 0) const {
+        static_assert(std::is_trivially_copyable_v<T>, "constant buffers are plain bytes");
+        T value;
+        readConstantBuffer(shaderRegister, space, sizeof(T), &value);
+        return value;
+    }
+
 private:
     // Stage masks for SV-1.
     static constexpr uint8_t bit(ShaderStage s) { return detail::stageBit(s); }
@@ -155,6 +246,16 @@ private:
     const uint8_t* readMemory(GpuVirtualAddress address, uint64_t size) const;
     void readBufferView(GpuDescriptorHandle tableHandle, uint32_t offset, uint64_t byteOffset, uint64_t size,
                         void* out) const;
+    // Register resolution (shader_resources.cpp).
+    friend class Texture2DRef;
+    detail::BoundResource resolve(DescriptorRangeType type, uint32_t shaderRegister, uint32_t space,
+                                  uint32_t arrayIndex, const char* hlslType) const;
+    [[noreturn]] void bindingError(const char* rule, const detail::BoundResource& bound, const std::string& what) const;
+    void readStructured(uint32_t shaderRegister, uint32_t space, uint32_t arrayIndex, uint64_t elementIndex,
+                        uint64_t size, void* out) const;
+    void readByteAddress(uint32_t shaderRegister, uint32_t space, uint32_t arrayIndex, uint64_t byteOffset,
+                         uint64_t size, void* out) const;
+    void readConstantBuffer(uint32_t shaderRegister, uint32_t space, uint64_t size, void* out) const;
 
     detail::Invocation& inv_;
 };

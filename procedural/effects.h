@@ -11,6 +11,15 @@
 
 namespace refray::procedural {
 
+// Whether the shadow call sites exist at all. The CMake option REFRAY_WITHOUT_SHADOW_MACHINERY compiles them out,
+// as if the HLSL traced no shadow rays; it exists only for docs/performance.md's check that a scene with shadows
+// switched off costs no more than a build without them.
+#ifdef REFRAY_WITHOUT_SHADOW_MACHINERY
+inline constexpr bool kShadowMachinery = false;
+#else
+inline constexpr bool kShadowMachinery = true;
+#endif
+
 struct Effects {
     // The closest hits' shadow rays. false: TraceShadowRayAndReportIfHit returns false ("not in shadow") without
     // tracing, exactly what it returns for a call at MAX_RAY_RECURSION_DEPTH, so every point counts as lit.

@@ -248,7 +248,11 @@ std::string cornellBoxObj() {
             for (const dvec3& p : q.points()) text += "v " + triple(p, 1) + "\n";
             text += "vn " + triple(newellNormal(q.points()), 6) + "\n";
             const auto corner = [&](uint32_t k) {
-                return " " + std::to_string(vertex + k) + "//" + std::to_string(normal);
+                std::string c = " ";  // appended piecewise: GCC 12's -Wrestrict misfires on "lit" + string chains
+                c += std::to_string(vertex + k);
+                c += "//";
+                c += std::to_string(normal);
+                return c;
             };
             text += "f" + corner(0) + corner(1) + corner(2) + "\n";
             text += "f" + corner(0) + corner(2) + corner(3) + "\n";

@@ -168,6 +168,7 @@ struct RenderOptions {
     bool stats = false;
     std::string statsJson;  // --stats-json FILE
     bool noShortcuts = false;  // --no-shortcuts: DispatchOptions::specialise off
+    bool noStageTimes = false;  // --no-stage-times: --stats without DispatchOptions::profileStages
     std::string order = "ordered";
     uint64_t seed = 0;  // RenderSettings::seed (the first batch's) and the adversarial order's seed
     std::optional<uint32_t> batches;  // --batches K: a statistics image of K renders
@@ -261,7 +262,7 @@ int runRender(const RenderOptions& o) {
     settings.precision = *precision;
     settings.spp = o.spp;
     for (const std::string& k : o.knobs) scenes::applyKnobAssignment(settings, k);
-    settings.profileStages = o.stats || !o.statsJson.empty();
+    settings.profileStages = (o.stats || !o.statsJson.empty()) && !o.noStageTimes;
     settings.specialise = !o.noShortcuts;
 
     scenes::RenderResult result;
@@ -389,6 +390,9 @@ int main(int argc, char** argv) {
     render->add_flag("--stats", ro.stats,
                      "Print rays per ray type and depth, invocations per export, and the exclusive time per stage");
     render->add_option("--stats-json", ro.statsJson, "Write the --stats measures to FILE as JSON (format refray-stats/1)");
+    render->add_flag("--no-stage-times", ro.noStageTimes,
+                     "With --stats or --stats-json: do not time the stages (their clocks cost a few per cent), for "
+                     "timing the render itself");
     render->add_flag("--no-shortcuts", ro.noShortcuts,
                      "Gather every candidate of every ray: no traversal shortcuts (for measuring them; the image is "
                      "the same)");

@@ -283,7 +283,7 @@ bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet&
                                   const Effects& effects, const tvec3<T>& origin, const tvec3<T>& direction,
                                   uint32_t currentRayRecursionDepth) {
     if (currentRayRecursionDepth >= maxDepth) return false;
-    if (!effects.traceShadowRays) return false;  // PORT: shadows switched off (procedural/effects.h)
+    if (!kShadowMachinery || !effects.traceShadowRays) return false;  // PORT: shadows switched off (procedural/effects.h)
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     // Starts as "hit": closest-hit and any-hit shaders are skipped, only Miss_Shadow clears it.
     ShadowRayPayload shadowPayload{0.0f, 1};
