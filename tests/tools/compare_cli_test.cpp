@@ -28,13 +28,7 @@ using refray::testing::dumpDom;
 
 CliRun compare(const std::string& arguments) { return runCommand(std::string(REFRAY_BINARY) + " compare " + arguments); }
 
-// A fresh directory per test under the test output directory.
-std::string directory(const std::string& name) {
-    const auto dir = std::filesystem::path(REFRAY_TEST_OUTPUT_DIR) / "compare" / name;
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    return dir.string();
-}
+std::string directory(const std::string& name) { return refray::testing::freshDirectory("compare", name); }
 
 Image noise(uint32_t width, uint32_t height, uint32_t seed) {
     Image image(width, height);
@@ -58,7 +52,7 @@ std::string write(const std::string& path, const Image& image) {
     return path;
 }
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using refray::testing::contains;
 
 // The <tr class="comparison ..."> rows of a report, in document order.
 std::vector<std::string> comparisonRows(const std::string& dom) {

@@ -16,16 +16,11 @@ using refray::testing::CliRun;
 
 const std::string kProceduray = std::string(REFRAY_SOURCE_DIR) + "/scenes/proceduray-mandel-julia-pac.json";
 
-CliRun run(const std::string& arguments) { return refray::testing::runCommand(std::string(REFRAY_BINARY) + " " + arguments); }
+CliRun run(const std::string& arguments) { return refray::testing::runRefray(arguments); }
 
-std::string directory(const std::string& name) {
-    const auto dir = std::filesystem::path(REFRAY_TEST_OUTPUT_DIR) / "explain" / name;
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    return dir.string();
-}
+std::string directory(const std::string& name) { return refray::testing::freshDirectory("explain", name); }
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using refray::testing::contains;
 
 }  // namespace
 

@@ -13,7 +13,7 @@ namespace {
 
 using refray::testing::CliRun;
 
-CliRun run(const std::string& arguments) { return refray::testing::runCommand(std::string(REFRAY_BINARY) + " " + arguments); }
+CliRun run(const std::string& arguments) { return refray::testing::runRefray(arguments); }
 
 std::string outputPath(const std::string& name) {
     std::filesystem::create_directories(REFRAY_TEST_OUTPUT_DIR);

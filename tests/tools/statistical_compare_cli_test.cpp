@@ -22,17 +22,11 @@ using refray::testing::CliRun;
 
 const std::string kD3D12 = std::string(REFRAY_SOURCE_DIR) + "/scenes/d3d12-procedural-geometry.json";
 
-CliRun run(const std::string& arguments) { return refray::testing::runCommand(std::string(REFRAY_BINARY) + " " + arguments); }
+CliRun run(const std::string& arguments) { return refray::testing::runRefray(arguments); }
 
-// A fresh directory per test under the test output directory.
-std::string directory(const std::string& name) {
-    const auto dir = std::filesystem::path(REFRAY_TEST_OUTPUT_DIR) / "statistical" / name;
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    return dir.string();
-}
+std::string directory(const std::string& name) { return refray::testing::freshDirectory("statistical", name); }
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using refray::testing::contains;
 
 // A statistics image of a noisy render: K batches of 0.5 + 0.1 N(0, 1) per channel, plus
 // `shift` in the 6x6 block at (8, 4).

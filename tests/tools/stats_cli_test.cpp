@@ -15,14 +15,14 @@ using refray::testing::CliRun;
 
 const std::string kD3D12 = std::string(REFRAY_SOURCE_DIR) + "/scenes/d3d12-procedural-geometry.json";
 
-CliRun run(const std::string& arguments) { return refray::testing::runCommand(std::string(REFRAY_BINARY) + " " + arguments); }
+CliRun run(const std::string& arguments) { return refray::testing::runRefray(arguments); }
 
 std::string outputPath(const std::string& name) {
     std::filesystem::create_directories(REFRAY_TEST_OUTPUT_DIR);
     return std::string(REFRAY_TEST_OUTPUT_DIR) + "/" + name;
 }
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+using refray::testing::contains;
 
 const refray::json::Value& member(const refray::json::Value& object, const std::string& key) {
     const refray::json::Value* v = object.find(key);

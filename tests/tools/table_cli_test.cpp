@@ -16,7 +16,7 @@ using refray::testing::CliRun;
 
 const std::string kProceduray = std::string(REFRAY_SOURCE_DIR) + "/scenes/proceduray-mandel-julia-pac.json";
 
-CliRun run(const std::string& arguments) { return refray::testing::runCommand(std::string(REFRAY_BINARY) + " " + arguments); }
+CliRun run(const std::string& arguments) { return refray::testing::runRefray(arguments); }
 
 // One AABB instance and two records in explicit layout; `contribution` is the instance's C.
 std::string oneBoxScene(int contribution) {
