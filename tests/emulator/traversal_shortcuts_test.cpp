@@ -87,9 +87,11 @@ Both runBoth(Stack& s, DispatchOptions options = {}, bool sameIntersections = tr
         EXPECT_EQ(s.results[i].misses, reference[i].misses);
         EXPECT_EQ(s.results[i].anyHits, reference[i].anyHits);
     }
-    for (size_t stage = 0; stage < b.with.invocations.size(); ++stage)
-        if (sameIntersections || ShaderStage(stage) != ShaderStage::Intersection)
+    for (size_t stage = 0; stage < b.with.invocations.size(); ++stage) {
+        if (sameIntersections || ShaderStage(stage) != ShaderStage::Intersection) {
             EXPECT_EQ(b.with.invocations[stage], b.without.invocations[stage]) << toString(ShaderStage(stage));
+        }
+    }
     EXPECT_EQ(b.with.raysTraced, b.without.raysTraced);
     EXPECT_EQ(b.without.raysPerGatherMode[kAll], b.without.raysTraced);
     return b;
