@@ -118,9 +118,58 @@ tvec4<T> MandelbulbSurfaceColor(tvec3<T> D, tvec3<T> N, tvec4<T> trap) {
     return tvec4<T>(col, T(1));
 }
 
-#define REFRAY_INSTANTIATE_HELPERS(T)                                                                   \
-    template tvec3<T> colorSurface<T>(tvec3<T>, tvec2<T>);                                              \
-    template tvec4<T> MandelbulbSurfaceColor<T>(tvec3<T>, tvec3<T>, tvec4<T>);
+namespace {
+
+template <typename T>
+T CalculateDiffuseCoefficient(const tvec3<T>& incidentLightRay, const tvec3<T>& normal) {
+    return hlsl::saturate(hlsl::dot(-incidentLightRay, normal));
+}
+
+template <typename T>
+T CalculateSpecularCoefficient(const tvec3<T>& incidentLightRay, const tvec3<T>& normal, T specularPower,
+                               const tvec3<T>& worldRayDirection) {
+    const tvec3<T> reflectedLightRay = hlsl::normalize(hlsl::reflect(incidentLightRay, normal));
+    return hlsl::pow(hlsl::saturate(hlsl::dot(reflectedLightRay, hlsl::normalize(-worldRayDirection))), specularPower);
+}
+
+}  // namespace
+
+// Phong = ambient (with the "fake AO" towards -y) + diffuse + specular; the light is a point light.
+template <typename T>
+tvec4<T> CalculatePhongLighting(const SceneConstantBuffer& g_sceneCB, tvec4<T> albedo, tvec3<T> normal, bool isInShadow,
+                                T diffuseCoef, T specularCoef, T specularPower, tvec3<T> hitPosition,
+                                tvec3<T> worldRayDirection) {
+    const tvec3<T> lightPosition = tvec3<T>(g_sceneCB.lightPosition);
+    const T shadowFactor = isInShadow ? T(kInShadowRadiance) : T(1);
+    const tvec3<T> incidentLightRay = hlsl::normalize(hitPosition - lightPosition);
+
+    // Diffuse component.
+    const tvec4<T> lightDiffuseColor = tvec4<T>(g_sceneCB.lightDiffuseColor);
+    const T Kd = CalculateDiffuseCoefficient(incidentLightRay, normal);
+    const tvec4<T> diffuseColor = shadowFactor * diffuseCoef * Kd * lightDiffuseColor * albedo;
+
+    // Specular component.
+    tvec4<T> specularColor(T(0));
+    if (!isInShadow) {
+        const tvec4<T> lightSpecularColor(T(1));
+        const T Ks = CalculateSpecularCoefficient(incidentLightRay, normal, specularPower, worldRayDirection);
+        specularColor = specularCoef * Ks * lightSpecularColor;
+    }
+
+    // Ambient component.
+    const tvec4<T> ambientColorMin = tvec4<T>(g_sceneCB.lightAmbientColor) - T(0.1f);
+    const tvec4<T> ambientColorMax = tvec4<T>(g_sceneCB.lightAmbientColor);
+    const T a = T(1) - hlsl::saturate(hlsl::dot(normal, tvec3<T>(0.0f, -1.0f, 0.0f)));
+    const tvec4<T> ambientColor = albedo * hlsl::lerp(ambientColorMin, ambientColorMax, a);
+
+    return ambientColor + diffuseColor + specularColor;
+}
+
+#define REFRAY_INSTANTIATE_HELPERS(T)                                                                          \
+    template tvec3<T> colorSurface<T>(tvec3<T>, tvec2<T>);                                                     \
+    template tvec4<T> MandelbulbSurfaceColor<T>(tvec3<T>, tvec3<T>, tvec4<T>);                                 \
+    template tvec4<T> CalculatePhongLighting<T>(const SceneConstantBuffer&, tvec4<T>, tvec3<T>, bool, T, T, T, \
+                                                tvec3<T>, tvec3<T>);
 REFRAY_INSTANTIATE_HELPERS(float)
 REFRAY_INSTANTIATE_HELPERS(double)
 #undef REFRAY_INSTANTIATE_HELPERS
@@ -210,51 +259,6 @@ math::RayExtent<T> CurrentExtent(const ShaderContext& ctx) {
     const uint32_t flags = ctx.RayFlags();
     return {T(ctx.RayTMin()), T(ctx.RayTCurrent()), (flags & RAY_FLAG_CULL_BACK_FACING_TRIANGLES) != 0,
             (flags & RAY_FLAG_CULL_FRONT_FACING_TRIANGLES) != 0};
-}
-
-template <typename T>
-T CalculateDiffuseCoefficient(const tvec3<T>& incidentLightRay, const tvec3<T>& normal) {
-    return hlsl::saturate(hlsl::dot(-incidentLightRay, normal));
-}
-
-template <typename T>
-T CalculateSpecularCoefficient(const ShaderContext& ctx, const tvec3<T>& incidentLightRay, const tvec3<T>& normal,
-                               T specularPower) {
-    const tvec3<T> reflectedLightRay = hlsl::normalize(hlsl::reflect(incidentLightRay, normal));
-    return hlsl::pow(hlsl::saturate(hlsl::dot(reflectedLightRay, hlsl::normalize(-tvec3<T>(ctx.WorldRayDirection())))),
-                     specularPower);
-}
-
-// Phong = ambient (with the "fake AO" towards -y) + diffuse + specular; the light is a point light.
-template <typename T>
-tvec4<T> CalculatePhongLighting(const ShaderContext& ctx, const SceneConstantBuffer& g_sceneCB, const tvec4<T>& albedo,
-                                const tvec3<T>& normal, bool isInShadow, T diffuseCoef, T specularCoef,
-                                T specularPower) {
-    const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
-    const tvec3<T> lightPosition = tvec3<T>(g_sceneCB.lightPosition);
-    const T shadowFactor = isInShadow ? T(kInShadowRadiance) : T(1);
-    const tvec3<T> incidentLightRay = hlsl::normalize(hitPosition - lightPosition);
-
-    // Diffuse component.
-    const tvec4<T> lightDiffuseColor = tvec4<T>(g_sceneCB.lightDiffuseColor);
-    const T Kd = CalculateDiffuseCoefficient(incidentLightRay, normal);
-    const tvec4<T> diffuseColor = shadowFactor * diffuseCoef * Kd * lightDiffuseColor * albedo;
-
-    // Specular component.
-    tvec4<T> specularColor(T(0));
-    if (!isInShadow) {
-        const tvec4<T> lightSpecularColor(T(1));
-        const T Ks = CalculateSpecularCoefficient(ctx, incidentLightRay, normal, specularPower);
-        specularColor = specularCoef * Ks * lightSpecularColor;
-    }
-
-    // Ambient component.
-    const tvec4<T> ambientColorMin = tvec4<T>(g_sceneCB.lightAmbientColor) - T(0.1f);
-    const tvec4<T> ambientColorMax = tvec4<T>(g_sceneCB.lightAmbientColor);
-    const T a = T(1) - hlsl::saturate(hlsl::dot(normal, tvec3<T>(0.0f, -1.0f, 0.0f)));
-    const tvec4<T> ambientColor = albedo * hlsl::lerp(ambientColorMin, ambientColorMax, a);
-
-    return ambientColor + diffuseColor + specularColor;
 }
 
 // TraceRay wrappers: both stop at MAX_RAY_RECURSION_DEPTH (black / "not in shadow"); TMin 0, TMax 10000.
@@ -395,9 +399,9 @@ void ClosestHit_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay
         reflectedColor = ReflectedColor(ctx, traceRay, maxDepth, triangleNormal, T(l_materialCB.reflectanceCoef),
                                         tvec3<T>(albedo), rayPayload.recursionDepth);
 
-    const tvec4<T> phongColor =
-        CalculatePhongLighting(ctx, g_sceneCB, albedo, triangleNormal, shadowRayHit, T(l_materialCB.diffuseCoef),
-                               T(l_materialCB.specularCoef), T(l_materialCB.specularPower));
+    const tvec4<T> phongColor = CalculatePhongLighting(
+        g_sceneCB, albedo, triangleNormal, shadowRayHit, T(l_materialCB.diffuseCoef), T(l_materialCB.specularCoef),
+        T(l_materialCB.specularPower), HitWorldPosition<T>(ctx), tvec3<T>(ctx.WorldRayDirection()));
     tvec4<T> color = phongColor + reflectedColor;
     color += tvec4<T>(rayPayload.color);
     rayPayload.dist += ctx.RayTCurrent();
@@ -456,9 +460,9 @@ void ClosestHit_Pacman(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, 
         reflectedColor = ReflectedColor(ctx, traceRay, maxDepth, normal, T(l_materialCB.reflectanceCoef),
                                         tvec3<T>(albedo), rayPayload.recursionDepth);
 
-    const tvec4<T> phongColor =
-        CalculatePhongLighting(ctx, g_sceneCB, albedo, normal, shadowRayHit, T(l_materialCB.diffuseCoef),
-                               T(l_materialCB.specularCoef), T(l_materialCB.specularPower));
+    const tvec4<T> phongColor = CalculatePhongLighting(
+        g_sceneCB, albedo, normal, shadowRayHit, T(l_materialCB.diffuseCoef), T(l_materialCB.specularCoef),
+        T(l_materialCB.specularPower), HitWorldPosition<T>(ctx), tvec3<T>(ctx.WorldRayDirection()));
     tvec4<T> color = tvec4<T>(attr.color) * (phongColor + reflectedColor);
     color += tvec4<T>(rayPayload.color);
     rayPayload.dist += ctx.RayTCurrent();
@@ -577,7 +581,8 @@ void ClosestHit_Julia(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, c
     const T specularCoef = T(0.08f);
     const T specularPower = T(0.2f);
     const tvec4<T> phongColor =
-        CalculatePhongLighting(ctx, g_sceneCB, albedo, normal, shadowRayHit, diffuseCoef, specularCoef, specularPower);
+        CalculatePhongLighting(g_sceneCB, albedo, normal, shadowRayHit, diffuseCoef, specularCoef, specularPower,
+                               HitWorldPosition<T>(ctx), tvec3<T>(ctx.WorldRayDirection()));
     tvec4<T> color = phongColor + reflectedColor;
     color += tvec4<T>(rayPayload.color);
     rayPayload.color = vec4(color);

@@ -188,6 +188,14 @@ glm::vec<3, T> colorSurface(glm::vec<3, T> pos, glm::vec<2, T> tn);
 template <typename T>
 glm::vec<4, T> MandelbulbSurfaceColor(glm::vec<3, T> D, glm::vec<3, T> N, glm::vec<4, T> trap);
 
+// Helpers.hlsli CalculatePhongLighting: ambient (darkened towards -y) + diffuse (scaled by kInShadowRadiance in shadow)
+// + white specular (only when not in shadow) for the point light of g_sceneCB.
+// PORT: HitWorldPosition() and WorldRayDirection(), which the HLSL reads inside, are parameters.
+template <typename T>
+glm::vec<4, T> CalculatePhongLighting(const SceneConstantBuffer& g_sceneCB, glm::vec<4, T> albedo, glm::vec<3, T> normal,
+                                      bool isInShadow, T diffuseCoef, T specularCoef, T specularPower,
+                                      glm::vec<3, T> hitPosition, glm::vec<3, T> worldRayDirection);
+
 // ---- The accuracy knobs as the entry points pass them (procedural/accuracy.h) ----------------------
 // PORT: each value is a constant of the HLSL; Accuracy{} gives exactly those constants, so every march is the
 // HLSL's bit for bit. Factors multiply in T (scaledConstant), step counts round with scaledSteps.
