@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/json.h"
+#include "tests/error_of.h"
 
 using namespace refray;
 using namespace refray::json;
@@ -22,16 +23,7 @@ std::string parseError(std::string_view text) {
     return "no error";
 }
 
-// The message `f` throws, or "no error".
-template <typename F>
-std::string errorOf(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "no error";
-}
+using refray::testing::errorOf;
 
 std::string at(const Location& location) { return toString(location); }
 
@@ -376,7 +368,7 @@ TEST(Json, ParseFileReportsMissingFile) {
 }
 
 TEST(Json, ParseFileNamesTheFileInLocations) {
-    const std::filesystem::path path = std::filesystem::path(testing::TempDir()) / "refray_json_test.json";
+    const std::filesystem::path path = std::filesystem::path(::testing::TempDir()) / "refray_json_test.json";
     {
         std::ofstream out(path, std::ios::binary);
         out << "{\n  \"a\": tru\n}\n";

@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "core/statistical_compare.h"
+#include "tests/error_of.h"
 
 using namespace refray;
 
@@ -80,15 +81,7 @@ void writeRawExr(const std::string& path, const std::vector<std::string>& channe
     ASSERT_TRUE(out->close());
 }
 
-template <typename F>
-std::string errorOf(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
-}
+using refray::testing::errorOf;
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 

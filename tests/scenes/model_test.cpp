@@ -16,6 +16,7 @@
 #include "scenes/asset_generator.h"
 #include "scenes/model.h"
 #include "scenes/model_buffers.h"
+#include "tests/error_of.h"
 
 namespace refray::scenes {
 namespace {
@@ -43,14 +44,7 @@ std::string readBytes(const fs::path& path) {
     return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-std::string errorOf(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
-}
+using refray::testing::errorOf;
 
 #define EXPECT_CONTAINS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
 

@@ -11,6 +11,7 @@
 #include "scenes/sweep.h"
 #include "scenes/sweep_report.h"
 #include "tests/scenes/scene_test_support.h"
+#include "tests/error_of.h"
 
 namespace refray::scenes {
 namespace {
@@ -20,14 +21,7 @@ using testing::readText;
 
 const std::string kD3D12 = std::string(REFRAY_SOURCE_DIR) + "/scenes/d3d12-procedural-geometry.json";
 
-std::string errorOf(const std::function<void()>& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
-}
+using refray::testing::errorOf;
 
 fs::path freshDirectory(const std::string& name) {
     const fs::path dir = fs::path(REFRAY_TEST_OUTPUT_DIR) / name;
