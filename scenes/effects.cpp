@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <optional>
 
 #include "core/strings.h"
 #include "scenes/shader_libraries.h"
@@ -229,11 +230,51 @@ std::string depthSource(const SceneDesc& scene, const procedural::Accuracy& knob
     return "the HLSL's";
 }
 
+// Whether every export that does an effect is the ray generation shader: it traces iteratively (a path), at depth 1,
+// so MAX_RAY_RECURSION_DEPTH does not limit it.
+bool tracedByRayGeneration(const Activity& a, const SceneDesc& scene) {
+    return !a.exports.empty() && std::all_of(a.exports.begin(), a.exports.end(),
+                                             [&](const std::string& x) { return x == scene.rayGeneration; });
+}
+
+// The path length of a library whose constants hold maxBounces: the scene constants buffer's (its name and value).
+struct PathLength {
+    std::string buffer;
+    uint32_t maxBounces = 0;
+};
+std::optional<PathLength> pathLength(const SceneDesc& scene, const ShaderLibraryBinding& binding) {
+    const auto& keys = binding.constantsKeys;
+    if (std::find(keys.begin(), keys.end(), "maxBounces") == keys.end()) return std::nullopt;
+    for (const BufferDesc& b : scene.buffers)
+        if (b.kind == BufferDesc::Kind::SceneConstants) return PathLength{b.name, b.maxBounces};
+    return std::nullopt;
+}
+
+// Textures or normal maps of the models' materials that a table binds ({"textures": ...}).
+Effect textureEffect(const SceneDesc& scene, const ShaderLibraryFacts& facts, ShaderEffect which, const char* name,
+                     const char* does, const char* singular, const char* plural, const char* mtlKeys) {
+    const Activity a = activity(scene, facts, which);
+    if (a.exports.empty()) return effect(name, false, notRun(a, scene, concat(does, " ", plural).c_str()));
+    const auto& paths =
+        which == ShaderEffect::Textures ? scene.modelBuffers.diffuseTextures : scene.modelBuffers.normalTextures;
+    size_t bound = 0;
+    for (const GlobalArgumentDesc& argument : scene.globalArguments)
+        for (const GlobalArgumentDesc::TableEntry& entry : argument.table)
+            bound += entry.isTexture && std::find(paths.begin(), paths.end(), entry.texture) != paths.end() ? 1 : 0;
+    if (paths.empty())
+        return effect(name, false, concat("no material of the models has a ", singular, " (", mtlKeys, ")"));
+    if (bound == 0)
+        return effect(name, false, concat("the models have ", counted(paths.size(), singular, plural),
+                                          ", but no descriptor table binds them"));
+    return effect(name, true, concat(subject(a.exports, does, does), " ", counted(paths.size(), singular, plural),
+                                     " (", mtlKeys, ")"));
+}
+
 }  // namespace
 
 std::vector<Effect> EffectSet::list() const {
-    return {triangles,     procedural,    anyHit,      triangleCulling,  shadowRays,  reflections,
-            animation,     supersampling, distanceFog, rayDifferentials, debugColours};
+    return {triangles,     procedural,  anyHit,      triangleCulling,  shadowRays,   reflections, animation,
+            supersampling, distanceFog, rayDifferentials, debugColours, textures, normalMaps};
 }
 
 procedural::Accuracy libraryAccuracy(const SceneDesc& scene, const procedural::Accuracy& knobs) {
@@ -264,7 +305,9 @@ std::string describeEffectsBlock(const EffectsDesc& block) {
 }
 
 EffectSet computeEffects(const SceneDesc& scene, const RenderSettings& settings) {
-    const ShaderLibraryFacts& facts = findShaderLibrary(scene.shaderLibrary).facts;
+    const ShaderLibraryBinding& binding = findShaderLibrary(scene.shaderLibrary);
+    const ShaderLibraryFacts& facts = binding.facts;
+    const std::optional<PathLength> path = pathLength(scene, binding);
     const procedural::Accuracy accuracy = libraryAccuracy(scene, settings.accuracy);
     EffectSet e;
     e.recursionDepth = accuracy.maxRecursionDepth.value_or(facts.maxRayRecursionDepth);
@@ -286,18 +329,32 @@ EffectSet computeEffects(const SceneDesc& scene, const RenderSettings& settings)
     {
         const Activity a = activity(scene, facts, ShaderEffect::ShadowRays);
         const char* name = "shadow rays";
+        const std::string shadowType = scene.rayTypes.size() > facts.shadowRayType
+                                           ? inQuotes(scene.rayTypes[facts.shadowRayType].name)
+                                           : std::string("shadow");
         if (a.exports.empty()) {
             e.shadowRays = effect(name, false, notRun(a, scene, "traces shadow rays"));
         } else if (!scene.effects.shadows) {
             e.shadowRays = effect(name, false, concat("the scene's effects block sets \"shadows\": false, so ",
                                                           subject(a.exports, "takes", "take"), " every point as lit"));
+        } else if (tracedByRayGeneration(a, scene)) {
+            const uint32_t lights = scene.lightTriangleCount();
+            if (path && path->maxBounces == 0)
+                e.shadowRays = effect(name, false, concat("maxBounces is 0 in buffer ", inQuotes(path->buffer),
+                                                          ": paths end at their first hit, before light sampling"));
+            else if (lights == 0)
+                e.shadowRays = effect(name, false, "the scene has no light triangles (lightCount 0) to sample");
+            else
+                e.shadowRays = effect(name, true,
+                                      concat(subject(a.described, "traces", "trace"), " ", shadowType,
+                                             " rays from every path vertex to a point on one of ",
+                                             counted(lights, "light triangle", "light triangles")));
         } else if (e.recursionDepth < 2) {
             e.shadowRays = effect(name, false, concat(depthText, ": hits at depth 1 trace no shadow rays"));
         } else {
             std::string reason = subject(a.exports, "traces", "trace");
             reason += ' ';
-            reason += scene.rayTypes.size() > facts.shadowRayType ? inQuotes(scene.rayTypes[facts.shadowRayType].name)
-                                                                  : std::string("shadow");
+            reason += shadowType;
             reason += " rays towards the light from hits at depth 1";
             if (e.recursionDepth > 2) {
                 reason += "..";
@@ -315,6 +372,17 @@ EffectSet computeEffects(const SceneDesc& scene, const RenderSettings& settings)
         const char* name = "reflections";
         if (a.exports.empty()) {
             e.reflections = effect(name, false, notRun(a, scene, "traces reflection rays"));
+        } else if (tracedByRayGeneration(a, scene)) {
+            if (path && path->maxBounces == 0)
+                e.reflections = effect(name, false, concat("maxBounces is 0 in buffer ", inQuotes(path->buffer),
+                                                           ": paths end at their first hit"));
+            else
+                e.reflections = effect(
+                    name, true,
+                    concat(subject(a.described, "traces", "trace"), " them in a loop at depth 1",
+                           path ? concat(", up to maxBounces ", std::to_string(path->maxBounces), " per path (buffer ",
+                                         inQuotes(path->buffer), ")")
+                                : std::string()));
         } else if (e.recursionDepth < 2) {
             e.reflections = effect(name, false, concat(depthText, ": hits at depth 1 trace no reflection rays"));
         } else {
@@ -360,8 +428,16 @@ EffectSet computeEffects(const SceneDesc& scene, const RenderSettings& settings)
             e.animation = effect("animation", true, joined(parts, "; "));
     }
 
-    // Supersampling.
-    {
+    // Supersampling: a grid of pixel centres, or the shader's own random samples.
+    if (binding.samplesInShader) {
+        e.supersampling = effect("supersampling", settings.spp > 1,
+                                 settings.spp > 1
+                                     ? concat("spp ", std::to_string(settings.spp), ": ", std::to_string(settings.spp),
+                                              " random paths per pixel (samplesPerPixel), each through a jittered "
+                                              "point of the pixel, averaged by ",
+                                              scene.rayGeneration)
+                                     : std::string("spp 1: one random path per pixel"));
+    } else {
         uint32_t k = 1;
         while ((k + 1) * (k + 1) <= settings.spp) ++k;
         std::string reason = "spp ";
@@ -397,23 +473,29 @@ EffectSet computeEffects(const SceneDesc& scene, const RenderSettings& settings)
                              " over the footprint of the neighbouring pixels' camera rays");
     }
     {
-        const ShaderLibraryBinding& binding = findShaderLibrary(scene.shaderLibrary);
         std::vector<std::string> flagged, clear;
         for (const BufferDesc& b : scene.buffers) {
             if (b.kind != BufferDesc::Kind::SceneConstants) continue;
             (b.debugFlag != 0 ? flagged : clear).push_back(inQuotes(b.name));
         }
+        const std::string& flag = binding.debugFlagName;
         if (!binding.hasDebugFlag)
             e.debugColours = effect("debug colours", false,
                                     concat("library ", inQuotes(scene.shaderLibrary), " has no debugFlag"));
         else if (!flagged.empty())
             e.debugColours = effect("debug colours", true,
-                                    concat("debugFlag is set in ", joined(flagged), ": hits report t = 0 in flat colours"));
+                                    concat(flag, " is set in ", joined(flagged),
+                                           flag == "debugFlag" ? ": hits report t = 0 in flat colours"
+                                                               : ": the first hit's attributes, not its radiance"));
         else
             e.debugColours = effect("debug colours", false,
                                     clear.empty() ? std::string("no sceneConstants buffer")
-                                                  : concat("debugFlag is 0 in ", joined(clear)));
+                                                  : concat(flag, " is 0 in ", joined(clear)));
     }
+    e.textures = textureEffect(scene, facts, ShaderEffect::Textures, "textures", "samples", "diffuse texture",
+                               "diffuse textures", "map_Kd");
+    e.normalMaps = textureEffect(scene, facts, ShaderEffect::NormalMaps, "normal maps", "perturbs normals with",
+                                 "normal map", "normal maps", "norm, map_Bump");
     return e;
 }
 

@@ -35,7 +35,9 @@ struct EffectSet {
     Effect supersampling;     // more than one camera ray per pixel
     Effect distanceFog;       // closest hits blend towards the background with the hit distance
     Effect rayDifferentials;  // closest hits filter a texture over the neighbouring pixels' camera-ray footprint
-    Effect debugColours;      // the scene constants' debugFlag replaces shading with flat colours
+    Effect debugColours;      // the scene constants' debugFlag (debugMode) replaces shading with flat colours
+    Effect textures;          // closest hits sample the models' diffuse textures (bound in a descriptor table)
+    Effect normalMaps;        // closest hits perturb the shading normal with the models' normal maps
     // The shaders' MAX_RAY_RECURSION_DEPTH: TraceRay levels, camera rays being level 1 (1: camera rays only).
     uint32_t recursionDepth = 0;
     // The pipeline's MaxTraceRecursionDepth (at least recursionDepth).

@@ -60,6 +60,25 @@ GoldenSet readGoldenManifest(const fs::path& manifest) {
         r.finish();
         set.entries.push_back(std::move(e));
     }
+    if (const json::Value* statistical = top.optional("statistical"))
+        for (const json::Value& v : statistical->asArray()) {
+            json::ObjectReader r(v, "a statistical golden entry");
+            StatisticalGoldenEntry e;
+            e.name = r.required("name").asString();
+            e.scene = r.required("scene").asString();
+            e.sceneSha256 = r.required("sceneSha256").asString();
+            e.camera = r.required("camera").asString();
+            e.width = r.required("width").asUint32();
+            e.height = r.required("height").asUint32();
+            e.spp = r.required("spp").asUint32();
+            e.batches = r.required("batches").asUint32();
+            e.seed = r.required("seed").asUint32();
+            e.image = r.required("image").asString();
+            e.refrayCommit = r.required("refrayCommit").asString();
+            r.finish();
+            if (e.batches < 2) v.fail("a statistical golden needs at least 2 batches");
+            set.statistical.push_back(std::move(e));
+        }
     top.finish();
     return set;
 }
@@ -78,7 +97,22 @@ void writeGoldenManifest(const fs::path& manifest, const GoldenSet& set) {
             << ", \"orderCheckOrders\": " << e.orders << ", \"orderDependentPixels\": " << e.orderDependentPixels
             << ", \"refrayCommit\": " << jsonString(e.refrayCommit) << "}";
     }
-    out << "\n  ]\n}\n";
+    out << "\n  ]";
+    if (!set.statistical.empty()) {
+        out << ",\n  \"statistical\": [";
+        for (size_t i = 0; i < set.statistical.size(); ++i) {
+            const StatisticalGoldenEntry& e = set.statistical[i];
+            out << (i ? ",\n" : "\n") << "    {\"name\": " << jsonString(e.name)
+                << ", \"scene\": " << jsonString(e.scene)
+                << ", \"sceneSha256\": " << jsonString(e.sceneSha256) << ",\n     \"camera\": " << jsonString(e.camera)
+                << ", \"width\": " << e.width << ", \"height\": " << e.height << ", \"spp\": " << e.spp
+                << ", \"batches\": " << e.batches << ", \"seed\": " << e.seed
+                << ",\n     \"image\": " << jsonString(e.image) << ", \"refrayCommit\": " << jsonString(e.refrayCommit)
+                << "}";
+        }
+        out << "\n  ]";
+    }
+    out << "\n}\n";
     // json::Value's asFloat reads the time back from its text; the manifest keeps times as strings so no digit is lost.
     std::ofstream file(manifest, std::ios::binary);
     REFRAY_CHECK(file, "cannot write " << manifest.string());
@@ -100,6 +134,34 @@ RenderSettings goldenSettings(const GoldenEntry& entry, uint32_t threads) {
     return s;
 }
 
+RenderSettings goldenSettings(const StatisticalGoldenEntry& entry, uint32_t firstSeed, uint32_t batch,
+                              uint32_t threads) {
+    RenderSettings s;
+    s.width = entry.width;
+    s.height = entry.height;
+    s.threads = threads;
+    s.camera = entry.camera;
+    s.spp = entry.spp;
+    s.seed = firstSeed + batch;
+    return s;
+}
+
+bool isMonteCarlo(const SceneDesc& scene) { return findShaderLibrary(scene.shaderLibrary).samplesInShader; }
+
+StatisticsImage renderStatistics(Scene& scene, const StatisticalGoldenEntry& entry, uint32_t firstSeed,
+                                 uint32_t batches, uint32_t threads) {
+    StatisticsAccumulator accumulator;
+    for (uint32_t k = 0; k < batches; ++k)
+        accumulator.add(scene.render(goldenSettings(entry, firstSeed, k, threads)).image);
+    StatisticsImage stats = accumulator.finish();
+    stats.mean.metadata["seed"] = std::to_string(firstSeed);
+    std::string seeds = std::to_string(firstSeed);
+    seeds += "..";
+    seeds += std::to_string(firstSeed + batches - 1);
+    stats.mean.metadata["statistics_seeds"] = seeds;
+    return stats;
+}
+
 GoldenSet updateGoldens(const GoldenUpdateOptions& options) {
     std::vector<fs::path> files;
     for (const auto& f : fs::directory_iterator(options.repositoryRoot / "scenes"))
@@ -109,9 +171,12 @@ GoldenSet updateGoldens(const GoldenUpdateOptions& options) {
     fs::create_directories(options.goldenDirectory);
 
     GoldenSet set;
+    const fs::path manifest = options.goldenDirectory / "goldens.json";
+    if (fs::exists(manifest)) set.statistical = readGoldenManifest(manifest).statistical;
     for (const fs::path& file : files) {
         Scene scene(loadSceneFile(file));
         const SceneDesc& desc = scene.desc();
+        if (isMonteCarlo(desc)) continue;  // statistical goldens only (below)
         for (const CameraDesc& camera : desc.cameras) {
             const auto start = std::chrono::steady_clock::now();
             GoldenEntry e;
@@ -137,7 +202,20 @@ GoldenSet updateGoldens(const GoldenUpdateOptions& options) {
                 options.onEntry(e, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
         }
     }
-    writeGoldenManifest(options.goldenDirectory / "goldens.json", set);
+    for (StatisticalGoldenEntry& e : set.statistical) {
+        const auto start = std::chrono::steady_clock::now();
+        Scene scene(loadSceneFile(options.repositoryRoot / e.scene));
+        e.sceneSha256 = scene.desc().fileHash;
+        e.refrayCommit = options.refrayCommit;
+        StatisticsImage stats = renderStatistics(scene, e, e.seed, e.batches, options.threads);
+        stats.mean.metadata["refray_commit"] = options.refrayCommit;
+        writeStatisticsImage((options.goldenDirectory / e.image).string(), stats);
+        if (options.onStatisticalEntry) {
+            const auto seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            options.onStatisticalEntry(e, seconds);
+        }
+    }
+    writeGoldenManifest(manifest, set);
     return set;
 }
 

@@ -9,7 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "core/statistical_compare.h"
 #include "scenes/order_check.h"
+#include "scenes/scene.h"
 
 namespace refray::scenes {
 
@@ -31,8 +33,25 @@ struct GoldenEntry {
     std::string refrayCommit;
 };
 
+// A statistical golden (docs/compare.md, "The Cornell box golden"): for a scene whose shaders sample at random
+// (ShaderLibraryBinding::samplesInShader), a statistics image (core/statistical_compare.h) of `batches` renders with
+// seeds seed .. seed + batches - 1 at `spp`; a test re-renders it with other seeds and compares statistically.
+struct StatisticalGoldenEntry {
+    std::string name;         // "<scene name>.<camera>"
+    std::string scene;        // scene file, relative to the repository root
+    std::string sceneSha256;  // of the scene file when the golden was made
+    std::string camera;
+    uint32_t width = 0, height = 0;
+    uint32_t spp = 1;
+    uint32_t batches = 2;
+    uint32_t seed = 0;   // the first batch's
+    std::string image;   // statistics EXR, relative to the manifest
+    std::string refrayCommit;
+};
+
 struct GoldenSet {
-    std::vector<GoldenEntry> entries;
+    std::vector<GoldenEntry> entries;  // threshold goldens: every camera of every deterministic scene file
+    std::vector<StatisticalGoldenEntry> statistical;
 };
 
 GoldenSet readGoldenManifest(const std::filesystem::path& manifest);
@@ -40,6 +59,17 @@ void writeGoldenManifest(const std::filesystem::path& manifest, const GoldenSet&
 
 // The settings a golden entry was made with (threads as given).
 RenderSettings goldenSettings(const GoldenEntry& entry, uint32_t threads);
+// The settings of batch `batch` of a statistical golden, seeded `firstSeed` + batch (entry.seed for the golden itself).
+RenderSettings goldenSettings(const StatisticalGoldenEntry& entry, uint32_t firstSeed, uint32_t batch,
+                              uint32_t threads);
+// Whether a scene's renders are Monte Carlo estimates (its library samples at random), so that it gets statistical
+// goldens, not threshold ones.
+bool isMonteCarlo(const SceneDesc& scene);
+
+// The statistics image of `batches` renders of a statistical golden's scene and camera with seeds firstSeed,
+// firstSeed + 1, ... (the golden itself: entry.batches from entry.seed).
+StatisticsImage renderStatistics(Scene& scene, const StatisticalGoldenEntry& entry, uint32_t firstSeed,
+                                 uint32_t batches, uint32_t threads);
 
 struct GoldenUpdateOptions {
     std::filesystem::path repositoryRoot;  // scene paths are relative to it
@@ -49,10 +79,13 @@ struct GoldenUpdateOptions {
     uint32_t threads = 0;
     std::string refrayCommit;
     std::function<void(const GoldenEntry&, double seconds)> onEntry;  // after each entry is written
+    std::function<void(const StatisticalGoldenEntry&, double seconds)> onStatisticalEntry;
 };
 
 // Renders every top-level scenes/*.json x camera at the scene's default time, with an order check, writes
-// <name>.exr, <name>.order-mask.png and goldens.json into goldenDirectory, and returns the set.
+// <name>.exr, <name>.order-mask.png and goldens.json into goldenDirectory, and returns the set. Monte Carlo scenes
+// (isMonteCarlo) get no threshold golden: the statistical entries of the existing manifest are kept, each
+// re-rendered with its own settings (size, spp, batches, seed; `width`/`height` above do not apply).
 GoldenSet updateGoldens(const GoldenUpdateOptions& options);
 
 }  // namespace refray::scenes

@@ -186,18 +186,16 @@ pt::PathTracerConstants PathTracerScene::constants(uint32_t width, uint32_t heig
     CameraDesc camera;
     camera.name = state_->desc.name;
     camera.model = CameraModel::MiniEngine;  // right-handed: screen right = forward x up
-    camera.eye = glm::dvec3(c.eye);
-    camera.target = glm::dvec3(c.target);
-    camera.up = glm::dvec3(c.up);
-    camera.fovYRadians = double(c.fovYDegrees) * 3.14159265358979323846 / 180.0;
-    // Only directions matter (rays unproject the far plane), so the planes just follow the scene's scale.
-    const double distance = glm::length(camera.target - camera.eye);
-    camera.nearZ = 0.01 * distance;
-    camera.farZ = 10.0 * distance;
+    camera.eye = c.eye;
+    camera.target = c.target;
+    camera.up = c.up;
+    camera.fovYRadians = c.fovYDegrees * 3.14159265358979323846 / 180.0;  // as the scene loader converts it
+    camera.nearZ = c.nearZ;
+    camera.farZ = c.farZ;
 
     pt::PathTracerConstants cb{};
     cb.projectionToWorld = projectionToWorld(camera, width, height);
-    cb.cameraPosition = vec4(c.eye, 1.0f);
+    cb.cameraPosition = vec4(vec3(c.eye), 1.0f);
     cb.backgroundColor = vec4(state_->desc.backgroundColor, 1.0f);
     cb.samplesPerPixel = spp;
     cb.maxBounces = options.maxBounces;
@@ -256,14 +254,14 @@ PathTracerSceneDesc sceneFromObj(const std::filesystem::path& path, std::string 
 
 PathTracerScene PathTracerScene::cornellBox(const std::filesystem::path& scenesDirectory) {
     PathTracerSceneDesc desc = sceneFromObj(scenesDirectory / "cornell-box" / "cornell-box.obj", "cornell-box");
-    desc.camera = {vec3(278.0f, 273.0f, -800.0f), vec3(278.0f, 273.0f, 0.0f), vec3(0.0f, 1.0f, 0.0f), 39.3077f};
+    desc.camera = {{278.0, 273.0, -800.0}, {278.0, 273.0, 0.0}, {0.0, 1.0, 0.0}, 39.3077, 8.0, 8000.0};
     desc.backgroundColor = vec3(0.0f);
     return PathTracerScene(std::move(desc));
 }
 
 PathTracerScene PathTracerScene::texturedRoom(const std::filesystem::path& scenesDirectory) {
     PathTracerSceneDesc desc = sceneFromObj(scenesDirectory / "textured-room" / "textured-room.obj", "textured-room");
-    desc.camera = {vec3(0.0f, 2.4f, 5.6f), vec3(0.0f, 0.9f, -0.6f), vec3(0.0f, 1.0f, 0.0f), 50.0f};
+    desc.camera = {{0.0, 2.4, 5.6}, {0.0, 0.9, -0.6}, {0.0, 1.0, 0.0}, 50.0, 0.05, 100.0};
     desc.backgroundColor = vec3(0.05f, 0.06f, 0.08f);
     return PathTracerScene(std::move(desc));
 }

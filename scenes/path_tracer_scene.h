@@ -29,11 +29,15 @@
 
 namespace refray::scenes {
 
+// The camera, in double as a scene file gives it: the MiniEngine model (scenes/camera_models.h), whose
+// projectionToWorld the shaders unproject (only directions matter, so the planes just bracket the scene).
 struct PathTracerCamera {
-    vec3 eye{0.0f, 0.0f, 5.0f};
-    vec3 target{0.0f};
-    vec3 up{0.0f, 1.0f, 0.0f};
-    float fovYDegrees = 45.0f;  // vertical
+    glm::dvec3 eye{0.0, 0.0, 5.0};
+    glm::dvec3 target{0.0};
+    glm::dvec3 up{0.0, 1.0, 0.0};
+    double fovYDegrees = 45.0;  // vertical
+    double nearZ = 0.01;
+    double farZ = 100.0;
 };
 
 struct PathTracerSceneDesc {
@@ -62,10 +66,12 @@ public:
 
     // `scenesDirectory` is the source tree's scenes/ folder (the library does not bake in a path).
     // <scenes>/cornell-box/cornell-box.obj (walls, short-block, tall-block, light) and the Cornell data's camera:
-    // eye (278, 273, -800), target (278, 273, 0), up +y, vertical field of view 39.3077 degrees; black background.
+    // eye (278, 273, -800), target (278, 273, 0), up +y, vertical field of view 39.3077 degrees (planes 8 and
+    // 8000); black background. scenes/cornell-box.json describes the same DXR objects.
     static PathTracerScene cornellBox(const std::filesystem::path& scenesDirectory);
     // <scenes>/textured-room/textured-room.obj (floor, back-wall, sphere, box, torus, light), seen from the front
     // and above so that every object shows; a dim blue-grey background (the room is open).
+    // scenes/textured-room.json describes the same DXR objects.
     static PathTracerScene texturedRoom(const std::filesystem::path& scenesDirectory);
 
     // DispatchRays over width x height with `spp` paths per pixel; `threads` 0 uses every hardware thread. The

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <map>
 
 #include "core/error.h"
 #include "core/strings.h"
@@ -83,16 +84,29 @@ uint32_t sampleGridSize(uint32_t spp) {
     return k;
 }
 
+// The dispatch's samples per pixel in each dimension: k for a k x k grid, 1 for a library whose shaders draw the
+// samples themselves (ShaderLibraryBinding::samplesInShader).
+uint32_t sampleGridSize(uint32_t spp, const ShaderLibraryBinding& binding) {
+    if (!binding.samplesInShader) return sampleGridSize(spp);
+    REFRAY_CHECK(spp >= 1 && spp <= binding.maxSamplesPerPixel,
+                 "--spp for library '" << binding.name << "' is the number of random paths per pixel that its ray "
+                                       << "generation shader averages (samplesPerPixel), 1 to "
+                                       << binding.maxSamplesPerPixel << "; got " << spp);
+    return 1;
+}
+
 }  // namespace
 
 Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
     GpuMemory& memory = device_.memory();
 
-    // Data buffers.
+    // Data buffers and the model buffers; an empty one (no light triangles) has no address and binds as a null
+    // descriptor.
     bufferAddresses_.resize(desc_.buffers.size(), 0);
     for (size_t i = 0; i < desc_.buffers.size(); ++i) {
         const BufferDesc& b = desc_.buffers[i];
-        if (b.kind == BufferDesc::Kind::Data) bufferAddresses_[i] = memory.upload(b.bytes.data(), b.bytes.size(), b.name);
+        if (b.isStatic() && !b.bytes.empty())
+            bufferAddresses_[i] = memory.upload(b.bytes.data(), b.bytes.size(), b.name);
     }
 
     // One BLAS per bottom-level entry, geometries in file order (GeometryIndex, IDX-4).
@@ -134,6 +148,19 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
     for (const RootSignatureDesc& l : desc_.localSignatures) localSignatures_.push_back(RootSignature::create(l));
     for (const GlobalArgumentDesc& a : desc_.globalArguments) heapSize_ += uint32_t(a.table.size());
     if (heapSize_ > 0) heap_ = &device_.createDescriptorHeap(heapSize_, desc_.name + " descriptor heap");
+
+    // The models' textures (linear, as the files store them), one Texture2D per file however often it is bound.
+    std::map<std::filesystem::path, Texture2DPtr> loaded;
+    for (const GlobalArgumentDesc& a : desc_.globalArguments)
+        for (const GlobalArgumentDesc::TableEntry& e : a.table) {
+            if (!e.isTexture || e.texture.empty() || loaded.count(e.texture)) continue;
+            loaded.emplace(e.texture, Texture2D::fromFile(e.texture.string()));
+        }
+    for (const GlobalArgumentDesc& a : desc_.globalArguments) {
+        std::vector<Texture2DPtr>& textures = tableTextures_.emplace_back();
+        for (const GlobalArgumentDesc::TableEntry& e : a.table)
+            textures.push_back(e.isTexture && !e.texture.empty() ? loaded.at(e.texture) : Texture2DPtr{});
+    }
 
     pipelineFor({});  // validates the state object and the tables now
 }
@@ -182,7 +209,7 @@ Scene::Pipeline& Scene::pipelineFor(const LibraryOptions& options) {
         for (const RecordDesc::Argument& a : r.arguments) {
             if (a.buffer >= 0) {
                 // Generated buffers have no fixed address; local root descriptors must point at data.
-                REFRAY_CHECK(desc_.buffers[size_t(a.buffer)].kind == BufferDesc::Kind::Data,
+                REFRAY_CHECK(desc_.buffers[size_t(a.buffer)].isStatic(),
                              json::toString(r.where) << ": " << r.origin << " binds generated buffer '"
                                                      << desc_.buffers[size_t(a.buffer)].name
                                                      << "' as a local root descriptor; records are written once, so "
@@ -199,7 +226,7 @@ Scene::Pipeline& Scene::pipelineFor(const LibraryOptions& options) {
 }
 
 GpuVirtualAddress Scene::generateBuffer(const BufferDesc& b, const CameraDesc& camera, float time, uint32_t width,
-                                        uint32_t height, uint32_t seed) {
+                                        uint32_t height, uint32_t seed, uint32_t samplesPerPixel) {
     GpuMemory& memory = device_.memory();
     switch (b.kind) {
         case BufferDesc::Kind::SceneConstants: {
@@ -210,6 +237,10 @@ GpuVirtualAddress Scene::generateBuffer(const BufferDesc& b, const CameraDesc& c
             in.elapsedTime = time;
             in.debugFlag = b.debugFlag;
             in.seed = seed;
+            in.backgroundColor = b.backgroundColor;
+            in.maxBounces = b.maxBounces;
+            in.lightCount = desc_.lightTriangleCount();
+            in.samplesPerPixel = samplesPerPixel;
             const std::vector<uint8_t> bytes = findShaderLibrary(desc_.shaderLibrary).sceneConstants(in);
             return memory.upload(bytes, b.name);
         }
@@ -235,16 +266,18 @@ GpuVirtualAddress Scene::generateBuffer(const BufferDesc& b, const CameraDesc& c
             }
             return memory.upload(matrices, b.name);
         }
-        case BufferDesc::Kind::Data: break;
+        default: break;
     }
-    REFRAY_ASSERT(false, "buffer '" << b.name << "' is not generated");
+    REFRAY_ASSERT(false, "buffer '" << b.name << "' is not generated each frame");
     return 0;
 }
 
 RenderResult Scene::render(const RenderSettings& settings) {
-    const uint32_t k = sampleGridSize(settings.spp);
+    const ShaderLibraryBinding& binding = findShaderLibrary(desc_.shaderLibrary);
+    const uint32_t k = sampleGridSize(settings.spp, binding);
     REFRAY_CHECK(k == 1 || !settings.region, "a launch region (one pixel's explanation) needs one sample per pixel, got --spp "
                                                  << settings.spp);
+    const uint32_t shaderSamples = binding.samplesInShader ? settings.spp : 1;
     const uint32_t width = settings.width * k, height = settings.height * k;
     REFRAY_CHECK(settings.width > 0 && settings.height > 0 && width <= 65536 && height <= 65536,
                  "the dispatch " << width << "x" << height << " (size x sqrt(spp)) is outside 1x1 .. 65536x65536");
@@ -256,27 +289,38 @@ RenderResult Scene::render(const RenderSettings& settings) {
     Image target(width, height);
     std::vector<GpuVirtualAddress> frameAddresses(desc_.buffers.size(), 0);
     for (size_t i = 0; i < desc_.buffers.size(); ++i)
-        frameAddresses[i] = desc_.buffers[i].kind == BufferDesc::Kind::Data
+        frameAddresses[i] = desc_.buffers[i].isStatic()
                                 ? bufferAddresses_[i]
-                                : generateBuffer(desc_.buffers[i], camera, time, width, height, settings.seed);
+                                : generateBuffer(desc_.buffers[i], camera, time, width, height, settings.seed,
+                                                 shaderSamples);
 
     GlobalRootArguments globals(globalSignature_);
     uint32_t slot = 0;
-    for (const GlobalArgumentDesc& a : desc_.globalArguments) {
+    for (size_t argument = 0; argument < desc_.globalArguments.size(); ++argument) {
+        const GlobalArgumentDesc& a = desc_.globalArguments[argument];
         switch (a.kind) {
             case GlobalArgumentDesc::Kind::AccelerationStructure: globals.setDescriptor(a.parameter, tlas_); break;
             case GlobalArgumentDesc::Kind::Buffer: globals.setDescriptor(a.parameter, frameAddresses[size_t(a.buffer)]); break;
             case GlobalArgumentDesc::Kind::Table:
                 globals.setDescriptor(a.parameter, heap_->gpuHandle(slot));
-                for (const GlobalArgumentDesc::TableEntry& e : a.table) {
+                for (size_t entry = 0; entry < a.table.size(); ++entry) {
+                    const GlobalArgumentDesc::TableEntry& e = a.table[entry];
                     if (e.renderTarget) {
                         heap_->setTexture2D(slot++, DescriptorRangeType::UAV, &target);
                         continue;
                     }
+                    if (e.isTexture) {
+                        heap_->setTexture2D(slot++, tableTextures_[argument][entry]);
+                        continue;
+                    }
                     const BufferDesc& b = desc_.buffers[size_t(e.buffer)];
-                    const uint64_t size = b.kind == BufferDesc::Kind::Data ? b.bytes.size()
-                                                                           : device_.memory().find(frameAddresses[size_t(e.buffer)])->size();
-                    heap_->setBuffer(slot++, e.type, {frameAddresses[size_t(e.buffer)], size, e.stride});
+                    const GpuVirtualAddress address = frameAddresses[size_t(e.buffer)];
+                    if (address == 0) {  // an empty model buffer: a null descriptor
+                        heap_->setBuffer(slot++, e.type, BufferView{});
+                        continue;
+                    }
+                    const uint64_t size = b.isStatic() ? b.bytes.size() : device_.memory().find(address)->size();
+                    heap_->setBuffer(slot++, e.type, {address, size, e.stride});
                 }
                 break;
         }

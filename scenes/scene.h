@@ -1,5 +1,6 @@
-// A scene file turned into DXR objects: one device with the BLASes, the TLAS and the data buffers, and per
-// precision a state object with its shader tables. Renders any camera, time, size and sample count.
+// A scene file turned into DXR objects: one device with the BLASes, the TLAS, the data and model buffers and the
+// models' textures, and per precision a state object with its shader tables. Renders any camera, time, size and
+// sample count.
 #pragma once
 
 #include <map>
@@ -46,7 +47,7 @@ private:
     };
     Pipeline& pipelineFor(const LibraryOptions& options);
     dxr::GpuVirtualAddress generateBuffer(const BufferDesc& buffer, const CameraDesc& camera, float time, uint32_t width,
-                                          uint32_t height, uint32_t seed);
+                                          uint32_t height, uint32_t seed, uint32_t samplesPerPixel);
 
     SceneDesc desc_;
     dxr::Device device_;
@@ -58,6 +59,8 @@ private:
     std::map<LibraryOptions, Pipeline> pipelines_;
     dxr::DescriptorHeap* heap_ = nullptr;
     uint32_t heapSize_ = 0;
+    // Per global argument and table entry: the Texture2D of a texture entry (null otherwise, or for a null one).
+    std::vector<std::vector<dxr::Texture2DPtr>> tableTextures_;
 };
 
 // Loads, validates and builds a scene file.

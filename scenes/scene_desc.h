@@ -15,6 +15,7 @@
 #include "emulator/root_signature.h"
 #include "emulator/state_object.h"
 #include "scenes/camera_models.h"
+#include "scenes/model_buffers.h"
 #include "scenes/shader_libraries.h"
 
 namespace refray::scenes {
@@ -28,18 +29,42 @@ struct PrimitiveTransformDesc {  // one element of a "primitiveTransforms" buffe
 
 struct BufferDesc {
     enum class Kind {
-        Data,                // bytes from the file
-        SceneConstants,      // the library's SceneConstantBuffer (camera, light, time)
-        InstanceTransforms,  // per listed instance: inverse(M), M as row-vector float4x4 (Proceduray §1.7)
-        PrimitiveTransforms  // per element: S·R·Tr, inverse (D3D12 sample §1.3)
+        Data,                    // bytes from the file
+        SceneConstants,          // the library's SceneConstantBuffer (camera, light, time)
+        InstanceTransforms,      // per listed instance: inverse(M), M as row-vector float4x4 (Proceduray §1.7)
+        PrimitiveTransforms,     // per element: S·R·Tr, inverse (D3D12 sample §1.3)
+        // Built once from the scene's models (scenes/model_buffers.h), in SceneDesc::models order:
+        ModelVertices,           // VertexGPU (48 bytes) of every model
+        ModelIndices,            // uint32 indices, local to their model
+        ModelMaterials,          // MaterialGPU (64 bytes) of every model
+        ModelTriangleMaterials,  // uint32 per triangle: index into ModelMaterials
+        ModelObjects,            // ObjectGPU (32 bytes) per instance, in instance order: its model's offsets
+        LightTriangles,          // LightTriangleGPU (64 bytes): the emissive triangles of the instances, world space
     };
     std::string name;
     Kind kind = Kind::Data;
-    std::vector<uint8_t> bytes;   // Data
-    uint32_t stride = 0;          // Data: the element stride the file declared (0: raw)
+    std::vector<uint8_t> bytes;   // Data and the model kinds (isStatic)
+    uint32_t stride = 0;          // Data: the element stride the file declared (0: raw); model kinds: the element size
     std::vector<uint32_t> instances;                   // InstanceTransforms: indices into SceneDesc::instances
     std::vector<PrimitiveTransformDesc> primitives;    // PrimitiveTransforms
-    int32_t debugFlag = 0;                             // SceneConstants
+    // SceneConstants: the library's debug switch (debugFlag or debugMode) and, for libraries whose constants have
+    // them (ShaderLibraryBinding::constantsKeys), the background radiance and the path length.
+    int32_t debugFlag = 0;
+    vec3 backgroundColor{0.0f};
+    uint32_t maxBounces = 8;
+    json::Location where;
+
+    // Uploaded once when the scene is built (Data and the model kinds); the others are written each frame.
+    bool isStatic() const {
+        return kind != Kind::SceneConstants && kind != Kind::InstanceTransforms && kind != Kind::PrimitiveTransforms;
+    }
+};
+
+// A model of the scene's "models": an OBJ file (or one object of it) loaded by scenes/model.h.
+struct ModelDesc {
+    std::string name;
+    std::filesystem::path file;  // the OBJ file, resolved against the scene file's folder
+    std::string object;          // the OBJ object ("o"/"g" name); empty: the whole file
     json::Location where;
 };
 
@@ -59,6 +84,9 @@ struct GeometryDescFile {
     // AABBs: a data buffer of RaytracingAABB (24 bytes each).
     uint32_t aabbBuffer = 0;
     uint32_t aabbCount = 0;
+    // Triangles from a model ({"model": NAME}): its index in SceneDesc::models, -1 otherwise. The views above then
+    // point at the model's range of the ModelVertices and ModelIndices buffers.
+    int32_t model = -1;
 };
 
 struct BlasDesc {
@@ -127,6 +155,10 @@ struct GlobalArgumentDesc {
         bool renderTarget = false;  // the output UAV
         int32_t buffer = -1;
         uint32_t stride = 0;        // 0: raw view (ByteAddressBuffer)
+        // A Texture2D SRV of one of the models' textures (an entry {"textures": ...} becomes one per texture);
+        // `texture` empty with `isTexture`: a null Texture2D descriptor (the models have no texture of that kind).
+        bool isTexture = false;
+        std::filesystem::path texture;
         dxr::DescriptorRangeType type = dxr::DescriptorRangeType::SRV;
     };
     uint32_t parameter = 0;
@@ -187,6 +219,10 @@ struct SceneDesc {
     std::vector<std::vector<std::string>> localAssociations;
 
     // Resources.
+    std::vector<ModelDesc> models;
+    // The models' global buffers (scenes/model_buffers.h): models in `models` order, one object per instance when
+    // every instance holds a model (objects and objectDescs empty otherwise); the texture lists of the tables.
+    GlobalModelBuffers modelBuffers;
     std::vector<BufferDesc> buffers;
     std::vector<BlasDesc> blases;
     std::vector<InstanceDescFile> instances;
@@ -209,6 +245,8 @@ struct SceneDesc {
 
     const CameraDesc& camera(const std::string& name) const;  // "" = the default; error lists the cameras
     int32_t findBuffer(const std::string& name) const;
+    // The elements of the scene's lightTriangles buffer (its lightCount), 0 without one.
+    uint32_t lightTriangleCount() const;
 };
 
 }  // namespace refray::scenes

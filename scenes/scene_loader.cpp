@@ -12,6 +12,8 @@
 #include "core/hash.h"
 #include "core/strings.h"
 #include "scenes/mesh.h"
+#include "scenes/model.h"
+#include "scenes/path_tracer_scene.h"
 
 namespace refray::scenes {
 
@@ -175,6 +177,7 @@ public:
         parseRayTypes(top.required("rayTypes"));
         parseHitGroups(top.required("hitGroups"));
         parseRootSignatures(top.required("rootSignatures"));
+        if (const Value* v = top.optional("models")) parseModels(*v);
         const Value& buffers = top.required("buffers");
         parseDataBuffers(buffers);
         parseBottomLevel(top.required("bottomLevel"));
@@ -192,9 +195,19 @@ public:
         deriveAssociations();
         parseGlobalArguments(top.required("globalArguments"));
         parseCameras(top.required("cameras"), top.optional("defaultCamera"));
-        parseLight(top.required("light"));
+        if (binding_->usesLight) {
+            parseLight(top.required("light"));
+        } else if (const Value* v = top.optional("light")) {
+            v->fail("the " + binding_->name + " scene constants hold no light (a path tracer's lights are emissive "
+                    "triangles: a {\"generate\": \"lightTriangles\"} buffer); remove 'light'");
+        }
         if (const Value* v = top.optional("time")) parseTime(*v);
-        if (const Value* v = top.optional("effects")) parseEffects(*v);
+        if (const Value* v = top.optional("effects")) {
+            if (!binding_->configurable)
+                v->fail("the " + binding_->name + " shaders are built as written; there is no effect to switch off "
+                        "(remove 'effects')");
+            parseEffects(*v);
+        }
         if (const Value* v = top.optional("imageSize")) {
             const auto& a = v->asArray();
             if (a.size() != 2) v->fail("imageSize needs [width, height]");
@@ -311,7 +324,10 @@ private:
             if (declared != t.payload)
                 payload.fail("ray type " + inQuotes(t.name) + " says its payload is " + inQuotes(t.payload) +
                              ", but its miss shader " + inQuotes(t.miss) + " takes " + inQuotes(declared));
-            setTraceRayArguments(t, uint32_t(scene_.rayTypes.size()), r.optional("traceRay"));
+            const Value* traceRay = r.optional("traceRay");
+            if (traceRay && !binding_->configurable)
+                traceRay->fail("the " + binding_->name + " shaders pass fixed TraceRay arguments; remove 'traceRay'");
+            setTraceRayArguments(t, uint32_t(scene_.rayTypes.size()), traceRay);
             r.finish();
             scene_.rayTypes.push_back(t);
         }
@@ -420,8 +436,23 @@ private:
                     const auto [cls, n] = parseRegister(reg);
                     expectRegisterClass(reg, cls, "tubs"[t], "a " + std::string(dxr::toString(range.rangeType)) + " range");
                     range.baseShaderRegister = n;
-                    if (const Value* c = rr.optional("count")) range.numDescriptors = c->asUint32();
+                    if (const Value* c = rr.optional("count")) {
+                        if (c->isString()) {
+                            // HLSL `Texture2D t[] : register(t0, space5)`: a range of UINT_MAX descriptors.
+                            if (c->asString() != "unbounded")
+                                c->fail("a range's count is a number or \"unbounded\", got " + inQuotes(c->asString()));
+                            range.numDescriptors = dxr::kDescriptorRangeUnbounded;
+                        } else {
+                            range.numDescriptors = c->asUint32();
+                            if (range.numDescriptors == dxr::kDescriptorRangeUnbounded)
+                                c->fail("write an unbounded range as \"count\": \"unbounded\"");
+                        }
+                    }
                     if (range.numDescriptors == 0) rv.fail("a range needs at least one descriptor");
+                    if (!ranges.empty() && ranges.back().numDescriptors == dxr::kDescriptorRangeUnbounded)
+                        rv.fail("a range follows the unbounded range of " + what +
+                                "; scene files append ranges (OFFSET_APPEND), so an unbounded range must be the "
+                                "last of its table (BIND-9)");
                     if (const Value* s = rr.optional("space")) range.registerSpace = s->asUint32();
                     rr.finish();
                     ranges.push_back(range);
@@ -459,8 +490,75 @@ private:
             pr.finish();
             info.parameters.push_back(pi);
         }
+        if (const Value* samplers = r.optional("staticSamplers")) {
+            const auto& list = samplers->asArray();
+            for (size_t i = 0; i < list.size(); ++i)
+                desc.staticSamplers.push_back(parseStaticSampler(list[i], desc.name, i));
+        }
         r.finish();
         return desc;
+    }
+
+    // A D3D12_STATIC_SAMPLER_DESC: {"register": "s0", "space", "filter", "address" (all three) or "addressU" /
+    // "addressV" / "addressW", "mipLODBias", "maxAnisotropy", "borderColor", "minLOD", "maxLOD"}.
+    static dxr::StaticSamplerDesc parseStaticSampler(const Value& value, const std::string& signature, size_t index) {
+        static const std::vector<std::pair<std::string, dxr::SamplerFilter>> filters = {
+            {"point", dxr::FILTER_MIN_MAG_MIP_POINT},
+            {"linear", dxr::FILTER_MIN_MAG_MIP_LINEAR},
+            {"anisotropic", dxr::FILTER_ANISOTROPIC},
+            {"MIN_MAG_MIP_POINT", dxr::FILTER_MIN_MAG_MIP_POINT},
+            {"MIN_MAG_POINT_MIP_LINEAR", dxr::FILTER_MIN_MAG_POINT_MIP_LINEAR},
+            {"MIN_POINT_MAG_LINEAR_MIP_POINT", dxr::FILTER_MIN_POINT_MAG_LINEAR_MIP_POINT},
+            {"MIN_POINT_MAG_MIP_LINEAR", dxr::FILTER_MIN_POINT_MAG_MIP_LINEAR},
+            {"MIN_LINEAR_MAG_MIP_POINT", dxr::FILTER_MIN_LINEAR_MAG_MIP_POINT},
+            {"MIN_LINEAR_MAG_POINT_MIP_LINEAR", dxr::FILTER_MIN_LINEAR_MAG_POINT_MIP_LINEAR},
+            {"MIN_MAG_LINEAR_MIP_POINT", dxr::FILTER_MIN_MAG_LINEAR_MIP_POINT},
+            {"MIN_MAG_MIP_LINEAR", dxr::FILTER_MIN_MAG_MIP_LINEAR},
+            {"ANISOTROPIC", dxr::FILTER_ANISOTROPIC}};
+        static const std::vector<std::string> addressModes = {"wrap", "mirror", "clamp", "border", "mirror-once"};
+        static const std::vector<std::string> borderColors = {"transparent-black", "opaque-black", "opaque-white"};
+        std::string what = "static sampler ";
+        what += std::to_string(index);
+        what += " of root signature ";
+        what += inQuotes(signature);
+        ObjectReader r(value, what);
+        dxr::StaticSamplerDesc d;
+        const Value& reg = r.required("register");
+        const auto [cls, n] = parseRegister(reg);
+        expectRegisterClass(reg, cls, 's', "a static sampler");
+        d.ShaderRegister = n;
+        if (const Value* v = r.optional("space")) d.RegisterSpace = v->asUint32();
+        if (const Value* v = r.optional("filter")) {
+            std::vector<std::string> names;
+            for (const auto& f : filters) names.push_back(f.first);
+            d.Filter = filters[resolveName(*v, names, "sampler filter")].second;
+        }
+        const auto address = [&](const Value& v) {
+            return dxr::TextureAddressMode(resolveName(v, addressModes, "texture address mode") + 1);
+        };
+        const Value* all = r.optional("address");
+        const Value* u = r.optional("addressU");
+        const Value* v = r.optional("addressV");
+        const Value* w = r.optional("addressW");
+        if (all && (u || v || w))
+            (u ? u : v ? v : w)->fail("give 'address' (all three) or 'addressU' / 'addressV' / 'addressW', not both");
+        if (all) d.AddressU = d.AddressV = d.AddressW = address(*all);
+        if (u) d.AddressU = address(*u);
+        if (v) d.AddressV = address(*v);
+        if (w) d.AddressW = address(*w);
+        if (const Value* x = r.optional("mipLODBias")) d.MipLODBias = x->asFloat();
+        if (const Value* x = r.optional("maxAnisotropy")) d.MaxAnisotropy = x->asUint32();
+        if (const Value* x = r.optional("borderColor"))
+            d.BorderColor = dxr::StaticBorderColor(resolveName(*x, borderColors, "static border colour"));
+        if (const Value* x = r.optional("minLOD")) d.MinLOD = x->asFloat();
+        if (const Value* x = r.optional("maxLOD")) d.MaxLOD = x->asFloat();
+        r.finish();
+        try {
+            dxr::validateSamplerDesc(d.sampler(), what);
+        } catch (const Error& e) {
+            value.fail(e.what());
+        }
+        return d;
     }
 
     void parseRootSignatures(const Value& value) {
@@ -490,10 +588,153 @@ private:
         return uint32_t(scene_.buffers.size() - 1);
     }
 
+    // ---- models
+
+    // "models": [{"name", "file": an OBJ relative to the scene file, "object": one OBJ object of it}], in the order
+    // of the global model buffers.
+    void parseModels(const Value& value) {
+        std::map<std::filesystem::path, std::vector<Model>> files;  // loadObjModels per file, read once
+        for (const Value& v : value.asArray()) {
+            ObjectReader r(v, "a model");
+            ModelDesc desc;
+            desc.name = nonEmptyName(r.required("name"), "a model's name");
+            r.setWhat("model " + inQuotes(desc.name));
+            for (const ModelDesc& o : scene_.models)
+                if (o.name == desc.name) v.fail("two models are named " + inQuotes(desc.name));
+            desc.where = v.location();
+            const Value& file = r.required("file");
+            // Relative to the file that wrote the value (a lesson's base keeps its own directory).
+            desc.file = std::filesystem::path(file.location().file).parent_path() / file.asString();
+            const Value* object = r.optional("object");
+            r.finish();
+            Model model;
+            const std::vector<Model>* objects = nullptr;
+            try {
+                if (!object) {
+                    model = loadObjModel(desc.file);
+                } else {
+                    auto it = files.find(desc.file);
+                    if (it == files.end()) it = files.emplace(desc.file, loadObjModels(desc.file)).first;
+                    objects = &it->second;
+                }
+            } catch (const Error& e) {
+                file.fail("model " + inQuotes(desc.name) + ": " + e.what());
+            }
+            if (objects) {
+                desc.object = object->asString();
+                std::vector<std::string> names;
+                for (const Model& m : *objects) names.push_back(m.name);
+                const auto found = std::find(names.begin(), names.end(), desc.object);
+                if (found == names.end())
+                    object->fail("OBJ file " + desc.file.string() + " has no object " + inQuotes(desc.object) +
+                                 didYouMean(desc.object, names) + "; its objects: " + joined(names));
+                model = (*objects)[size_t(found - names.begin())];
+            }
+            model.name = desc.name;
+            modelNames_.push_back(desc.name);
+            models_.push_back(std::move(model));
+            scene_.models.push_back(std::move(desc));
+        }
+        if (scene_.models.empty()) value.fail("'models' lists no model; leave it out instead");
+        try {
+            scene_.modelBuffers = buildGlobalModelBuffers(models_, {});
+        } catch (const Error& e) {
+            value.fail(e.what());
+        }
+    }
+
+    // The model buffer kinds, as "generate" names them; the first four need only the models, the last two the
+    // instances too.
+    static const std::vector<std::pair<std::string, BufferDesc::Kind>>& modelBufferKinds() {
+        static const std::vector<std::pair<std::string, BufferDesc::Kind>> kinds = {
+            {"modelVertices", BufferDesc::Kind::ModelVertices},
+            {"modelIndices", BufferDesc::Kind::ModelIndices},
+            {"modelMaterials", BufferDesc::Kind::ModelMaterials},
+            {"modelTriangleMaterials", BufferDesc::Kind::ModelTriangleMaterials},
+            {"modelObjects", BufferDesc::Kind::ModelObjects},
+            {"lightTriangles", BufferDesc::Kind::LightTriangles}};
+        return kinds;
+    }
+
+    template <class T>
+    static void setElements(BufferDesc& b, const std::vector<T>& elements) {
+        b.stride = uint32_t(sizeof(T));
+        b.bytes.resize(elements.size() * sizeof(T));
+        if (!elements.empty()) std::memcpy(b.bytes.data(), elements.data(), b.bytes.size());
+    }
+
+    // A buffer generated from the models: {"generate": KIND} and no other key.
+    void addModelBuffer(const json::Member& m, BufferDesc::Kind kind) {
+        ObjectReader r(m.value, "buffer " + inQuotes(m.key));
+        const Value& generate = r.required("generate");
+        r.finish();
+        if (scene_.models.empty())
+            generate.fail("buffer " + inQuotes(m.key) + " is generated from the scene's 'models'; this scene has none");
+        for (const BufferDesc& other : scene_.buffers)
+            if (other.kind == kind)
+                generate.fail("buffer " + inQuotes(other.name) + " already is the scene's " + generate.asString() +
+                              " buffer; a scene has one of each");
+        BufferDesc b;
+        b.name = m.key;
+        b.kind = kind;
+        const GlobalModelBuffers& g = scene_.modelBuffers;
+        switch (kind) {
+            case BufferDesc::Kind::ModelVertices: setElements(b, g.vertices); break;
+            case BufferDesc::Kind::ModelIndices: setElements(b, g.indices); break;
+            case BufferDesc::Kind::ModelMaterials: setElements(b, g.materials); break;
+            case BufferDesc::Kind::ModelTriangleMaterials: setElements(b, g.triangleMaterials); break;
+            case BufferDesc::Kind::ModelObjects:
+                buildModelObjects(generate, m.key);
+                setElements(b, scene_.modelBuffers.objects);
+                break;
+            case BufferDesc::Kind::LightTriangles:
+                buildModelObjects(generate, m.key);
+                setElements(b, buildLightTriangles(scene_.modelBuffers));
+                break;
+            default: REFRAY_ASSERT(false, "not a model buffer kind");
+        }
+        addBuffer(std::move(b), m.value);
+    }
+
+    // One object per instance, in instance order (ObjectGPU and the light list read them): each instance must hold
+    // a BLAS of one geometry made from a model.
+    void buildModelObjects(const Value& where, const std::string& buffer) {
+        if (!scene_.modelBuffers.objectDescs.empty()) return;
+        std::vector<ModelObjectDesc> objects;
+        for (const InstanceDescFile& inst : scene_.instances) {
+            const BlasDesc& blas = scene_.blases[inst.blas];
+            if (blas.geometries.size() != 1 || blas.geometries[0].model < 0)
+                where.fail("buffer " + inQuotes(buffer) + " holds one object per instance, so every instance needs a "
+                           "BLAS of one geometry from a model; instance " + inQuotes(inst.name) + " holds BLAS " +
+                           inQuotes(blas.name) + ", which is not one");
+            objects.push_back({inst.name, uint32_t(blas.geometries[0].model), inst.transform});
+        }
+        try {
+            scene_.modelBuffers = buildGlobalModelBuffers(models_, objects);
+        } catch (const Error& e) {
+            where.fail(e.what());
+        }
+    }
+
+    // The kind of a model buffer that needs only the models ({"generate": "modelVertices"}, ...), else nullopt.
+    static std::optional<BufferDesc::Kind> staticModelKind(const Value& buffer) {
+        const Value* generate = buffer.find("generate");
+        if (!generate || !generate->isString()) return std::nullopt;
+        for (const auto& [name, kind] : modelBufferKinds())
+            if (name == generate->asString() && kind != BufferDesc::Kind::ModelObjects &&
+                kind != BufferDesc::Kind::LightTriangles)
+                return kind;
+        return std::nullopt;
+    }
+
     void parseDataBuffers(const Value& value) {
         for (const json::Member& m : value.asObject()) {
             if (!m.value.isObject()) m.value.fail("expected an object for buffer " + inQuotes(m.key) + ", got " +
                                                   std::string(m.value.kindName()));
+            if (const std::optional<BufferDesc::Kind> kind = staticModelKind(m.value)) {
+                addModelBuffer(m, *kind);  // before the geometry that reads it
+                continue;
+            }
             if (m.value.find("generate")) continue;  // after the instances
             ObjectReader r(m.value, "buffer " + inQuotes(m.key));
             BufferDesc b;
@@ -525,23 +766,42 @@ private:
     }
 
     void parseGeneratedBuffers(const Value& value) {
+        std::vector<std::string> kinds = {"sceneConstants", "instanceTransforms", "primitiveTransforms"};
+        for (const auto& k : modelBufferKinds()) kinds.push_back(k.first);
         for (const json::Member& m : value.asObject()) {
-            if (!m.value.find("generate")) continue;
+            if (!m.value.find("generate") || staticModelKind(m.value)) continue;
+            const uint32_t kind = resolveName(*m.value.find("generate"), kinds, "generated buffer kind");
+            if (kind >= 3) {
+                addModelBuffer(m, modelBufferKinds()[kind - 3].second);
+                continue;
+            }
             ObjectReader r(m.value, "buffer " + inQuotes(m.key));
+            r.required("generate");
             BufferDesc b;
             b.name = m.key;
-            const uint32_t kind = resolveName(r.required("generate"),
-                                              {"sceneConstants", "instanceTransforms", "primitiveTransforms"},
-                                              "generated buffer kind");
             if (kind == 0) {
                 b.kind = BufferDesc::Kind::SceneConstants;
-                if (const Value* d = r.optional("debugFlag")) {
+                const std::string flagKey = binding_->hasDebugFlag ? binding_->debugFlagName : "debugFlag";
+                if (const Value* d = r.optional(flagKey)) {
                     if (!binding_->hasDebugFlag)
                         d->fail("the " + binding_->name + " scene constants have no debugFlag");
                     const int64_t flag = d->asInt();
-                    if (flag < INT32_MIN || flag > INT32_MAX) d->fail("debugFlag does not fit in a 32-bit int");
+                    if (flag < INT32_MIN || flag > INT32_MAX) d->fail(flagKey + " does not fit in a 32-bit int");
                     b.debugFlag = int32_t(flag);
                 }
+                if (flagKey != "debugFlag")
+                    if (const Value* d = r.optional("debugFlag"))
+                        d->fail("the " + binding_->name + " scene constants have no debugFlag; their debug switch "
+                                "is '" + flagKey + "'");
+                const auto takes = [&](const char* key) {
+                    const auto& keys = binding_->constantsKeys;
+                    return std::find(keys.begin(), keys.end(), key) != keys.end();
+                };
+                if (takes("backgroundColor"))
+                    if (const Value* c = r.optional("backgroundColor"))
+                        b.backgroundColor = floatVector<3>(*c, "backgroundColor");
+                if (takes("maxBounces"))
+                    if (const Value* n = r.optional("maxBounces")) b.maxBounces = n->asUint32();
             } else if (kind == 1) {
                 b.kind = BufferDesc::Kind::InstanceTransforms;
                 for (const Value& v : r.required("instances").asArray())
@@ -581,16 +841,42 @@ private:
         std::vector<std::string> names;
         for (const BufferDesc& b : scene_.buffers) names.push_back(b.name);
         const uint32_t i = resolveName(nameValue, names, "buffer");
-        if (scene_.buffers[i].kind != BufferDesc::Kind::Data)
+        if (!scene_.buffers[i].isStatic())
             nameValue.fail("buffer " + inQuotes(nameValue.asString()) + " is generated each frame; geometry needs a data buffer");
         return int32_t(i);
     }
 
     // ---- geometry
 
+    // The scene's model buffer of `kind`, or an error at `where` saying to declare it.
+    uint32_t modelBuffer(BufferDesc::Kind kind, const Value& where) {
+        for (size_t i = 0; i < scene_.buffers.size(); ++i)
+            if (scene_.buffers[i].kind == kind) return uint32_t(i);
+        where.fail("a geometry from a model reads the models' vertex and index buffers; declare them in 'buffers': "
+                   "\"vertices\": {\"generate\": \"modelVertices\"}, \"indices\": {\"generate\": \"modelIndices\"}");
+    }
+
     GeometryDescFile parseTriangles(ObjectReader& r, const std::string& prefix) {
         GeometryDescFile g;
         g.type = dxr::GeometryType::Triangles;
+        if (const Value* model = r.optional("model")) {
+            // The model's range of the global buffers, as a DXR path tracer's host builds one BLAS per model:
+            // positions at byte 0 of each 48-byte VertexGPU, 32-bit indices local to the model.
+            if (r.optional("mesh") || r.optional("vertices") || r.optional("indices"))
+                model->fail("a triangle geometry takes 'model', 'mesh' or 'vertices' (and 'indices'), one of them");
+            g.model = int32_t(resolveName(*model, modelNames_, "model"));
+            const ObjectGPU& range = scene_.modelBuffers.modelRanges[size_t(g.model)];
+            g.vertexBuffer = modelBuffer(BufferDesc::Kind::ModelVertices, *model);
+            g.vertexOffset = uint64_t(range.vertexOffset) * sizeof(VertexGPU);
+            g.vertexStride = uint32_t(sizeof(VertexGPU));
+            g.vertexCount = range.vertexCount;
+            g.vertexFormat = dxr::Format::R32G32B32_FLOAT;
+            g.indexBuffer = int32_t(modelBuffer(BufferDesc::Kind::ModelIndices, *model));
+            g.indexOffset = uint64_t(range.indexOffset) * sizeof(uint32_t);
+            g.indexCount = range.indexCount;
+            g.indexFormat = dxr::Format::R32_UINT;
+            return g;
+        }
         if (const Value* mesh = r.optional("mesh")) {
             // An OBJ file, relative to the scene file: its positions and triangulated faces become two buffers.
             if (r.optional("vertices") || r.optional("indices"))
@@ -805,6 +1091,9 @@ private:
             inst.where = v.location();
             inst.blas = resolveName(r.required("blas"), blasNames_, "bottom-level structure");
             if (const Value* t = r.optional("transform")) inst.transform = parseTransform(*t);
+            // With models, InstanceID is the object index (= the instance index) that the shaders look objects
+            // up by, as a path tracer's host writes it.
+            if (!scene_.models.empty()) inst.instanceID = uint32_t(scene_.instances.size());
             if (const Value* id = r.optional("instanceID")) {
                 inst.instanceID = id->asUint32();
                 if (inst.instanceID > 0xFFFFFF) id->fail("InstanceID has 24 bits (INST-1), got " + std::to_string(inst.instanceID));
@@ -997,15 +1286,41 @@ private:
                 case dxr::RootParameterType::DescriptorTable: {
                     a.kind = GlobalArgumentDesc::Kind::Table;
                     std::vector<dxr::DescriptorRangeType> slots;
-                    for (const dxr::DescriptorRange& range : param.ranges)
+                    const dxr::DescriptorRange* unbounded = nullptr;  // the last range, when it is unbounded
+                    for (const dxr::DescriptorRange& range : param.ranges) {
+                        if (range.numDescriptors == dxr::kDescriptorRangeUnbounded) {
+                            unbounded = &range;
+                            break;
+                        }
                         for (uint32_t k = 0; k < range.numDescriptors; ++k) slots.push_back(range.rangeType);
+                    }
                     const auto& entries = v.asArray();
-                    if (entries.size() != slots.size())
+                    if (unbounded && entries.size() <= slots.size()) {
+                        std::string range = "(";
+                        range += dxr::registerLetter(unbounded->rangeType);
+                        range += std::to_string(unbounded->baseShaderRegister);
+                        range += ".., space ";
+                        range += std::to_string(unbounded->registerSpace);
+                        range += ")";
+                        v.fail("table " + inQuotes(name) + " ends in an unbounded range " + range + ", which needs " +
+                               "at least one descriptor after the " + std::to_string(slots.size()) +
+                               " of its other ranges; bind the models' textures with {\"textures\": \"diffuse\"} "
+                               "or {\"textures\": \"normal\"}");
+                    }
+                    if (!unbounded && entries.size() != slots.size())
                         v.fail("table " + inQuotes(name) + " has " + std::to_string(slots.size()) + " descriptors; " +
                                std::to_string(entries.size()) + " given");
                     for (size_t k = 0; k < entries.size(); ++k) {
                         GlobalArgumentDesc::TableEntry e;
-                        e.type = slots[k];
+                        e.type = k < slots.size() ? slots[k] : unbounded->rangeType;
+                        if (entries[k].isObject() && entries[k].find("textures")) {
+                            if (k < slots.size())
+                                entries[k].fail("{\"textures\": ...} binds as many descriptors as the models have "
+                                                "textures, so it belongs in an unbounded range; descriptor " +
+                                                std::to_string(k) + " of " + inQuotes(name) + " is in a bounded one");
+                            appendTextures(entries[k], e, a.table, name);
+                            continue;
+                        }
                         if (entries[k].isString()) {
                             if (entries[k].asString() != "@renderTarget")
                                 entries[k].fail("a table entry is \"@renderTarget\" or {\"buffer\": NAME, \"stride\": N}");
@@ -1037,6 +1352,28 @@ private:
             scene_.globalArguments.push_back(std::move(a));
         }
         r.finish();
+    }
+
+    // {"textures": "diffuse" | "normal"}: one Texture2D SRV per texture of the models' materials, in the order of
+    // GlobalModelBuffers (the indices MaterialGPU holds), or one null descriptor when there is none.
+    void appendTextures(const Value& value, GlobalArgumentDesc::TableEntry entry,
+                        std::vector<GlobalArgumentDesc::TableEntry>& table, const std::string& parameter) {
+        ObjectReader r(value, "a textures entry of " + inQuotes(parameter));
+        const Value& which = r.required("textures");
+        r.finish();
+        const uint32_t kind = resolveName(which, {"diffuse", "normal"}, "texture list");
+        if (scene_.models.empty())
+            which.fail("{\"textures\": ...} binds the textures of the scene's 'models'; this scene has none");
+        if (entry.type != dxr::DescriptorRangeType::SRV)
+            which.fail("textures are SRVs; the unbounded range of " + inQuotes(parameter) + " holds " +
+                       std::string(dxr::toString(entry.type)) + "s");
+        const auto& paths = kind == 0 ? scene_.modelBuffers.diffuseTextures : scene_.modelBuffers.normalTextures;
+        entry.isTexture = true;
+        if (paths.empty()) table.push_back(entry);
+        for (const std::filesystem::path& path : paths) {
+            entry.texture = path;
+            table.push_back(entry);
+        }
     }
 
     // ---- cameras, light, time
@@ -1144,7 +1481,8 @@ private:
     const Value* values_ = nullptr;
     std::vector<std::string> structNames_;
     std::vector<StructLayout> structs_;
-    std::vector<std::string> hitGroupNames_, localNames_, blasNames_, instanceNames_;
+    std::vector<std::string> hitGroupNames_, localNames_, blasNames_, instanceNames_, modelNames_;
+    std::vector<Model> models_;  // scene_.models, loaded
     SignatureInfo globalInfo_;
     std::vector<SignatureInfo> localInfo_;
     std::vector<const Value*> recordValues_;  // auto layout: each instance's "records"
@@ -1168,6 +1506,12 @@ int32_t SceneDesc::findBuffer(const std::string& bufferName) const {
     for (size_t i = 0; i < buffers.size(); ++i)
         if (buffers[i].name == bufferName) return int32_t(i);
     return -1;
+}
+
+uint32_t SceneDesc::lightTriangleCount() const {
+    for (const BufferDesc& b : buffers)
+        if (b.kind == BufferDesc::Kind::LightTriangles) return uint32_t(b.bytes.size() / b.stride);
+    return 0;
 }
 
 namespace {

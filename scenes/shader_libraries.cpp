@@ -6,6 +6,7 @@
 #include "core/error.h"
 #include "core/strings.h"
 #include "procedural/d3d12/d3d12_shaders.h"
+#include "procedural/pathtracer/pathtracer_shaders.h"
 #include "procedural/proceduray/proceduray_shaders.h"
 
 namespace refray::scenes {
@@ -104,28 +105,118 @@ ShaderLibraryFacts procedurayFacts() {
     return f;
 }
 
+std::vector<uint8_t> pathTracerConstants(const SceneConstantsInput& in) {
+    procedural::pathtracer::PathTracerConstants cb{};
+    cb.projectionToWorld = in.projectionToWorld;
+    cb.cameraPosition = in.cameraPosition;
+    cb.backgroundColor = vec4(in.backgroundColor, 1.0f);
+    cb.samplesPerPixel = in.samplesPerPixel;
+    cb.maxBounces = in.maxBounces;
+    cb.seed = in.seed;
+    cb.lightCount = in.lightCount;
+    cb.debugMode = uint32_t(in.debugFlag);
+    return bytesOf(cb);
+}
+
+// procedural/pathtracer/pathtracer_shaders.h: PT_RayGen traces every ray itself (an iterative path), radiance rays
+// with no flags and shadow rays that accept the first hit and skip the closest hit; PT_ClosestHit samples the
+// diffuse textures and the normal maps.
+ShaderLibraryFacts pathTracerFacts() {
+    namespace pt = procedural::pathtracer;
+    using E = ShaderEffect;
+    ShaderLibraryFacts f;
+    f.maxRayRecursionDepth = 1;  // no shader but the ray generation shader traces
+    f.shadowRayType = pt::RayType::Shadow;
+    f.rayFlags = {pt::kRadianceRayFlags, pt::kShadowRayFlags};
+    f.uses = {
+        {E::ShadowRays, "PT_RayGen", "next-event estimation", "", 0.0f},
+        {E::Reflections, "PT_RayGen", "the path's bounces", "", 0.0f},
+        {E::Textures, "PT_ClosestHit", "", "", 0.0f},
+        {E::NormalMaps, "PT_ClosestHit", "", "", 0.0f},
+    };
+    return f;
+}
+
+std::shared_ptr<dxr::ShaderLibrary> makePathTracer(procedural::Precision precision,
+                                                   const std::vector<procedural::TraceRayArguments>& traceRay,
+                                                   const procedural::Accuracy& accuracy,
+                                                   const procedural::Effects& effects,
+                                                   const std::vector<procedural::TraceRayArguments>& defaults) {
+    REFRAY_CHECK(precision == procedural::Precision::Float,
+                 "the dxr-path-tracer shaders exist in float only (the GPU's precision); --precision double is for "
+                 "the procedural libraries");
+    REFRAY_CHECK(traceRay == defaults, "the dxr-path-tracer shaders pass fixed TraceRay arguments (R = ray type, "
+                                       "M = 2, miss index = ray type, mask 0xFF)");
+    REFRAY_CHECK(accuracy.isDefault(), "the dxr-path-tracer shaders have no accuracy knobs (steps, thresholds, "
+                                       "iterations, recursion-depth); its spp is --spp");
+    REFRAY_CHECK(effects.isDefault(), "the dxr-path-tracer shaders have no effect switches");
+    return procedural::pathtracer::makePathTracerShaderLibrary();
+}
+
+ShaderLibraryBinding pathTracerBinding() {
+    namespace pt = procedural::pathtracer;
+    ShaderLibraryBinding b;
+    b.name = "dxr-path-tracer";
+    b.description = "refray's DXR path tracer over OBJ models in global buffers (procedural/pathtracer/)";
+    b.traceRayDefaults = {{pt::RayType::Radiance, pt::kGeometryStride, pt::RayType::Radiance, 0xFF},
+                          {pt::RayType::Shadow, pt::kGeometryStride, pt::RayType::Shadow, 0xFF}};
+    b.make = [defaults = b.traceRayDefaults](procedural::Precision p,
+                                             const std::vector<procedural::TraceRayArguments>& traceRay,
+                                             const procedural::Accuracy& accuracy, const procedural::Effects& effects) {
+        return makePathTracer(p, traceRay, accuracy, effects, defaults);
+    };
+    b.sceneConstants = pathTracerConstants;
+    b.hasDebugFlag = true;
+    b.debugFlagName = "debugMode";
+    b.rayTypeCount = pt::RayType::Count;
+    b.facts = pathTracerFacts();
+    b.samplesInShader = true;
+    b.maxSamplesPerPixel = 1u << 20;
+    b.constantsKeys = {"backgroundColor", "maxBounces"};
+    b.usesLight = false;
+    b.configurable = false;
+    return b;
+}
+
+ShaderLibraryBinding d3d12Binding() {
+    ShaderLibraryBinding b;
+    b.name = "d3d12-procedural-geometry";
+    b.description = "Microsoft D3D12RaytracingProceduralGeometry Raytracing.hlsl (procedural/d3d12/)";
+    b.make = [](procedural::Precision p, const std::vector<procedural::TraceRayArguments>& traceRay,
+                const procedural::Accuracy& accuracy, const procedural::Effects& effects) {
+        return procedural::d3d12::makeD3D12ShaderLibrary(p, argumentSet(traceRay, "d3d12-procedural-geometry"),
+                                                         accuracy, effects);
+    };
+    b.sceneConstants = d3d12Constants;
+    b.hasDebugFlag = false;
+    b.rayTypeCount = procedural::d3d12::RayType::Count;
+    b.traceRayDefaults = perRayType(procedural::d3d12::defaultTraceRayArguments().rayTypes);
+    b.facts = d3d12Facts();
+    return b;
+}
+
+ShaderLibraryBinding procedurayBinding() {
+    ShaderLibraryBinding b;
+    b.name = "proceduray";
+    b.description = "Proceduray MandelJuliaPac Raytracing.hlsl (procedural/proceduray/)";
+    b.make = [](procedural::Precision p, const std::vector<procedural::TraceRayArguments>& traceRay,
+                const procedural::Accuracy& accuracy, const procedural::Effects& effects) {
+        return procedural::proceduray::makeProcedurayShaderLibrary(p, argumentSet(traceRay, "proceduray"), accuracy,
+                                                                   effects);
+    };
+    b.sceneConstants = procedurayConstants;
+    b.hasDebugFlag = true;
+    b.rayTypeCount = procedural::proceduray::RayTypeCount;
+    b.traceRayDefaults = perRayType(procedural::proceduray::defaultTraceRayArguments().rayTypes);
+    b.facts = procedurayFacts();
+    return b;
+}
+
 }  // namespace
 
 const std::vector<ShaderLibraryBinding>& shaderLibraries() {
-    static const std::vector<ShaderLibraryBinding> libraries = {
-        {"d3d12-procedural-geometry",
-         "Microsoft D3D12RaytracingProceduralGeometry Raytracing.hlsl (procedural/d3d12/)",
-         [](procedural::Precision p, const std::vector<procedural::TraceRayArguments>& traceRay,
-            const procedural::Accuracy& accuracy, const procedural::Effects& effects) {
-             return procedural::d3d12::makeD3D12ShaderLibrary(p, argumentSet(traceRay, "d3d12-procedural-geometry"),
-                                                              accuracy, effects);
-         },
-         d3d12Constants, false, procedural::d3d12::RayType::Count,
-         perRayType(procedural::d3d12::defaultTraceRayArguments().rayTypes), d3d12Facts()},
-        {"proceduray", "Proceduray MandelJuliaPac Raytracing.hlsl (procedural/proceduray/)",
-         [](procedural::Precision p, const std::vector<procedural::TraceRayArguments>& traceRay,
-            const procedural::Accuracy& accuracy, const procedural::Effects& effects) {
-             return procedural::proceduray::makeProcedurayShaderLibrary(p, argumentSet(traceRay, "proceduray"), accuracy,
-                                                                        effects);
-         },
-         procedurayConstants, true, procedural::proceduray::RayTypeCount,
-         perRayType(procedural::proceduray::defaultTraceRayArguments().rayTypes), procedurayFacts()},
-    };
+    static const std::vector<ShaderLibraryBinding> libraries = {d3d12Binding(), pathTracerBinding(),
+                                                                procedurayBinding()};
     return libraries;
 }
 

@@ -24,14 +24,21 @@ struct LightDesc {
     vec4 diffuseColor{0.0f};
 };
 
-// What the host writes into the library's scene constant buffer for one frame.
+// What the host writes into the library's scene constant buffer for one frame. Each library takes the fields its
+// constant buffer has.
 struct SceneConstantsInput {
     procedural::Float4x4 projectionToWorld;
     vec4 cameraPosition{0.0f};
     LightDesc light;
     float elapsedTime = 0.0f;
-    int32_t debugFlag = 0;
-    uint32_t seed = 0;  // RenderSettings::seed
+    int32_t debugFlag = 0;   // debugFlag, or the path tracer's debugMode
+    uint32_t seed = 0;       // RenderSettings::seed
+    // The path tracer's (PathTracerConstants): the radiance of rays that leave the scene, scattering events per
+    // path, the number of light triangles, and the paths per pixel of the dispatch (RenderSettings::spp).
+    vec3 backgroundColor{0.0f};
+    uint32_t maxBounces = 8;
+    uint32_t lightCount = 0;
+    uint32_t samplesPerPixel = 1;
 };
 
 // What a library's shaders do that the scene's DXR objects do not show, from its fact sheet: the exports that trace
@@ -43,6 +50,8 @@ enum class ShaderEffect {
     Animation,         // reads elapsedTime
     DistanceFog,       // blends towards the background with the hit distance
     RayDifferentials,  // filters a texture over the footprint of the neighbouring pixels' camera rays
+    Textures,          // samples the models' diffuse textures
+    NormalMaps,        // perturbs the shading normal with the models' normal maps
 };
 struct ShaderEffectUse {
     ShaderEffect effect;
@@ -80,6 +89,21 @@ struct ShaderLibraryBinding {
     std::vector<procedural::TraceRayArguments> traceRayDefaults;
     // What the shaders do besides (for scenes/effects.h).
     ShaderLibraryFacts facts;
+    // The shaders draw `spp` random samples per pixel themselves (samplesPerPixel in the constants, keyed by the
+    // render's seed): --spp is any count from 1 to maxSamplesPerPixel and the dispatch is the image size. Otherwise
+    // --spp is a square k·k and the dispatch k times larger (a k x k grid of pixel centres, averaged).
+    bool samplesInShader = false;
+    uint32_t maxSamplesPerPixel = 256;
+    // The name of the debug switch on its sceneConstants buffer (with hasDebugFlag).
+    std::string debugFlagName = "debugFlag";
+    // Further keys its sceneConstants buffer takes: "backgroundColor", "maxBounces".
+    std::vector<std::string> constantsKeys;
+    // Its constants hold the scene's "light" (required then; refused otherwise).
+    bool usesLight = true;
+    // Its make() builds the shaders with other TraceRay arguments (a ray type's "traceRay"), the scene's "effects"
+    // block, the accuracy knobs and double precision. false: only the shaders as written (make() throws
+    // refray::Error for anything else, and the loader refuses "traceRay" and "effects").
+    bool configurable = true;
 };
 
 // The registered libraries, in name order.

@@ -372,7 +372,8 @@ int main(int argc, char** argv) {
     render->add_option("--precision", ro.precision, "Shader math precision: float (the GPU's) or double")
         ->capture_default_str();
     render->add_option("--spp", ro.spp, "Samples per pixel: a square number (k x k pixel centres of a k-times larger "
-                                        "dispatch, averaged)")
+                                        "dispatch, averaged); for dxr-path-tracer scenes any N (random paths per "
+                                        "pixel, averaged by the shader)")
         ->capture_default_str();
     render->add_option("--knob", ro.knobs,
                        "An accuracy knob, NAME=VALUE (repeatable): steps, threshold, mandelbulb-iterations, "

@@ -1,6 +1,7 @@
 // The golden set (tests/golden/goldens.json): every scene file x camera re-rendered and compared with the shared
 // comparator (core/compare.h), masked pixels reported apart. On failure the actual image, the expected one and
 // the diff heat map are written to the test output directory. Goldens change only through `refray golden update`.
+// Monte Carlo scenes have statistical goldens instead (statistical_golden_test.cpp).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -72,6 +73,7 @@ TEST(GoldenSet, ManifestCoversEveryCameraOfEverySceneFile) {
     for (const auto& f : fs::directory_iterator(fs::path(REFRAY_SOURCE_DIR) / "scenes")) {
         if (f.path().extension() != ".json") continue;
         const SceneDesc desc = loadSceneFile(f.path());
+        if (isMonteCarlo(desc)) continue;  // statistical goldens (statistical_golden_test.cpp)
         for (const CameraDesc& c : desc.cameras) {
             ++cameras;
             bool found = false;
@@ -83,6 +85,13 @@ TEST(GoldenSet, ManifestCoversEveryCameraOfEverySceneFile) {
     for (const GoldenEntry& e : set.entries) {
         EXPECT_TRUE(fs::exists(kGoldenDirectory / e.image)) << e.image;
         EXPECT_TRUE(fs::exists(kGoldenDirectory / e.mask)) << e.mask;
+    }
+    // Statistical goldens name a Monte Carlo scene's camera and have their statistics image.
+    for (const StatisticalGoldenEntry& e : set.statistical) {
+        const SceneDesc desc = loadSceneFile(fs::path(REFRAY_SOURCE_DIR) / e.scene);
+        EXPECT_TRUE(isMonteCarlo(desc)) << e.name << ": threshold goldens cover deterministic scenes";
+        EXPECT_EQ(e.name, desc.name + "." + desc.camera(e.camera).name);
+        EXPECT_TRUE(fs::exists(kGoldenDirectory / e.image)) << e.image;
     }
 }
 

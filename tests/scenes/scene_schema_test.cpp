@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <regex>
@@ -463,10 +464,14 @@ TEST(SceneSchema, ValidatorAppliesItsKeywords) {
 // ---- The scene files -----------------------------------------------------------------------------------------------
 
 TEST(SceneSchema, ReferenceScenesValidate) {
-    for (const std::string& path : {kProceduray, kD3D12}) {
-        const std::vector<std::string> errors = sceneSchema().validate(json::parseFile(path));
-        EXPECT_TRUE(errors.empty()) << path << "\n" << joinedLines(errors);
+    size_t files = 0;
+    for (const auto& f : std::filesystem::directory_iterator(kSourceDir + "/scenes")) {
+        if (f.path().extension() != ".json") continue;
+        ++files;
+        const std::vector<std::string> errors = sceneSchema().validate(json::parseFile(f.path()));
+        EXPECT_TRUE(errors.empty()) << f.path() << "\n" << joinedLines(errors);
     }
+    EXPECT_GE(files, 4u);
 }
 
 TEST(SceneSchema, DocumentedExampleValidatesLoadsAndRenders) {
@@ -506,6 +511,72 @@ TEST(SceneSchema, DocumentedRecordIndicesHold) {
     const SceneDesc d3d12 = loadSceneFile(kD3D12);
     EXPECT_EQ(d3d12.instances[1].contribution, 2u);
     EXPECT_EQ(d3d12.hitGroupRecords[1 + 2 * 1 + 2].hitGroup, "MyHitGroup_AABB_AnalyticPrimitive_ShadowRay");
+}
+
+// The ```json block under "### A complete path-tracer example" of docs/scene-format.md, and where it says to save it
+// (its model paths are relative to scenes/).
+std::string documentedPathTracerExample() {
+    const std::string doc = readText(kFormatDoc);
+    const size_t heading = doc.find("### A complete path-tracer example");
+    EXPECT_NE(heading, std::string::npos) << "no path-tracer example in " << kFormatDoc;
+    const std::string fence = "```json\n";
+    const size_t begin = heading == std::string::npos ? heading : doc.find(fence, heading);
+    if (begin == std::string::npos) return "";
+    const size_t end = doc.find("\n```", begin + fence.size());
+    return doc.substr(begin + fence.size(), end - begin - fence.size() + 1);
+}
+const std::string kPathTracerExample = kSourceDir + "/scenes/cornell-walls.json";
+
+TEST(SceneSchema, DocumentedPathTracerExampleValidatesLoadsAndRenders) {
+    const std::string text = documentedPathTracerExample();
+    ASSERT_FALSE(text.empty());
+    const std::vector<std::string> errors = schemaErrors(text, "path-tracer example");
+    EXPECT_TRUE(errors.empty()) << joinedLines(errors);
+
+    SceneDesc desc = parseScene(text, kPathTracerExample);
+    // What the document says: InstanceIDs 0 and 1, contributions 0 and 2, the light quad's two triangles, one null
+    // texture descriptor per texture table.
+    ASSERT_EQ(desc.instances.size(), 2u);
+    EXPECT_EQ(desc.instances[1].instanceID, 1u);
+    EXPECT_EQ(desc.instances[1].contribution, 2u);
+    EXPECT_EQ(desc.hitGroupRecords.at(0 + 2 * 0 + 2).hitGroup, "PT_HitGroup");
+    EXPECT_EQ(desc.modelBuffers.modelRanges.at(0).indexCount, 30u);
+    EXPECT_EQ(desc.modelBuffers.modelRanges.at(0).materialCount, 3u);
+    EXPECT_EQ(desc.lightTriangleCount(), 2u);
+    EXPECT_EQ(desc.globalArguments.at(4).table.size(), 1u);
+
+    Scene scene(std::move(desc));
+    RenderSettings settings;
+    settings.width = settings.height = 8;
+    settings.spp = 2;
+    settings.threads = 2;
+    const Image image = scene.render(settings).image;
+    float sum = 0.0f;
+    for (const vec4& p : image.pixels()) sum += p.r + p.g + p.b;
+    EXPECT_GT(sum, 0.0f);
+}
+
+// What the schema refuses of a path-tracer scene, and the loader too.
+TEST(SceneSchema, PathTracerRulesFail) {
+    const std::string text = documentedPathTracerExample();
+    const auto broken = [&](const char* from, const char* to, const char* schemaMessage) {
+        const std::string b = edited(text, from, to);
+        EXPECT_CONTAINS(joinedLines(schemaErrors(b, "broken.json")), schemaMessage);
+        try {
+            parseScene(b, kPathTracerExample);
+            ADD_FAILURE() << to << ": the loader accepts what the schema refuses";
+        } catch (const Error&) {
+        }
+    };
+    broken("\"imageSize\":", "\"light\": {\"position\": [0, 0, 0, 1], \"ambientColor\": [0, 0, 0, 1], \"diffuseColor\": [1, 1, 1, 1]}, \"imageSize\":",
+           "/light");
+    broken("\"payload\": \"ShadowPayload\"}", "\"payload\": \"ShadowPayload\", \"traceRay\": {\"multiplier\": 1}}", "/traceRay");
+    broken("\"filter\": \"anisotropic\"", "\"filter\": \"anisotropik\"", "not one of 'point'");
+    broken("\"space\": 6, \"count\": \"unbounded\"", "\"space\": 6, \"count\": \"unbound\"", "matches none of the oneOf");
+    broken("[{\"textures\": \"normal\"}]", "[{\"textures\": \"normals\"}]", "matches none of the oneOf");
+    broken("\"model\": \"light\"}]}", "\"model\": \"light\", \"mesh\": \"x.obj\"}]}", "matches none of the oneOf");
+    broken("\"maxBounces\": 4}", "\"maxBounces\": 4, \"debugFlag\": 1}", "/debugFlag");
+    broken("\"generate\": \"lightTriangles\"}", "\"generate\": \"lightTriangles\", \"stride\": 64}", "matches none of the oneOf");
 }
 
 // Each broken variant of the documented example fails the schema with `schemaMessage` and fails the loader too.
