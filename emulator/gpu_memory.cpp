@@ -61,7 +61,7 @@ void GpuMemory::write(GpuVirtualAddress va, const void* data, uint64_t n) {
     std::fill_n(buffer->written.begin() + offset, n, uint8_t(1));
 }
 
-const uint8_t* GpuMemory::read(GpuVirtualAddress va, uint64_t n, const std::string& what) const {
+const uint8_t* GpuMemory::read(GpuVirtualAddress va, uint64_t n, std::string_view what) const {
     const GpuBuffer* buffer = find(va, std::max<uint64_t>(n, 1));
     REFRAY_CHECK(buffer, what << ": " << n << " bytes at GPU address 0x" << std::hex << va << std::dec
                               << " are outside every buffer");

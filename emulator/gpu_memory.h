@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "emulator/types.h"
@@ -45,7 +46,8 @@ public:
     const GpuBuffer* find(GpuVirtualAddress va, uint64_t n = 1) const;
     GpuBuffer* find(GpuVirtualAddress va, uint64_t n = 1);
     // Pointer to [va, va+n); throws refray::Error naming `what` when the range is not mapped.
-    const uint8_t* read(GpuVirtualAddress va, uint64_t n, const std::string& what) const;
+    // `what` names the read in the error; a view, so a literal costs nothing when the read succeeds.
+    const uint8_t* read(GpuVirtualAddress va, uint64_t n, std::string_view what) const;
     // True if every byte of [va, va+n) was written by the host.
     bool isWritten(GpuVirtualAddress va, uint64_t n) const;
 

@@ -14,16 +14,12 @@ namespace refray::dxr {
 
 using detail::stageError;
 
-// The hot path of every constant-buffer and root-descriptor read: the message is built only on failure.
 const uint8_t* ShaderContext::readMemory(GpuVirtualAddress address, uint64_t size) const {
-    const GpuBuffer* buffer = inv_.dispatch->memory->find(address, std::max<uint64_t>(size, 1));
-    if (!buffer) {
-        std::ostringstream message;
-        message << "shader memory read: " << size << " bytes at GPU address 0x" << std::hex << address << std::dec
-                << " are outside every buffer";
-        stageError(inv_, "GEN-1", message.str());
+    try {
+        return inv_.dispatch->memory->read(address, size, "shader memory read");
+    } catch (const Error& e) {
+        stageError(inv_, "GEN-1", e.what());
     }
-    return buffer->bytes.data() + (address - buffer->base);
 }
 
 Image& ShaderContext::rwTexture2D(GpuDescriptorHandle tableHandle, uint32_t offset) const {
