@@ -64,7 +64,10 @@ struct ThreadState {
     std::vector<ExportCount> exportCounts;  // in first-call order: a handful of exports, searched linearly
     bool profiling = false;                 // DispatchOptions::profileStages
     StageClock clock;
+    LookupCache lookups;
 };
+
+LookupCache& lookupCache(Invocation& inv) { return inv.thread->lookups; }
 
 // Charges this thread's time to `stage` while alive, when profiling; otherwise one untaken branch each way.
 class ProfileScope {
@@ -131,10 +134,9 @@ struct Site {
     uint32_t depth;
 };
 
-Site siteOf(const Invocation& inv) {
-    static const std::string none;
-    return {inv.stage, inv.shader ? &inv.shader->name : &none, inv.depth};
-}
+const std::string kNoExport;
+
+Site siteOf(const Invocation& inv) { return {inv.stage, inv.shader ? &inv.shader->name : &kNoExport, inv.depth}; }
 
 Diagnostic locate(const ThreadState& ts, Diagnostic d, const Site& site) {
     d.site = DiagnosticSite{ts.launchIndex, site.depth, site.stage, *site.exportName};
@@ -212,6 +214,24 @@ void addHitValues(DiagnosticBuilder& b, const HitLookupContext* h) {
 bool lookupRecordChecked(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
                          const GpuVirtualAddressRangeAndStride& table, uint64_t index, RecordView& out,
                          const HitLookupContext* hit) {
+    // A record that passed these checks for this table, index and geometry type passes them again (LookupCache).
+    LookupCache::Record& cached = ts.lookups.records[LookupCache::recordSlot(index, uint8_t(kind))];
+    const uint8_t geometry = hit ? uint8_t(1 + uint8_t(hit->geometryType)) : uint8_t(0);
+    if (cached.index == index && cached.kind == uint8_t(kind) && cached.geometry == geometry &&
+        cached.table.StartAddress == table.StartAddress && cached.table.SizeInBytes == table.SizeInBytes &&
+        cached.table.StrideInBytes == table.StrideInBytes) {
+        out = cached.view;
+        return true;
+    }
+    auto remember = [&] {
+        cached.table = table;
+        cached.index = index;
+        cached.kind = uint8_t(kind);
+        cached.geometry = geometry;
+        cached.view = out;
+        return true;
+    };
+
     const DispatchState& ds = *ts.dispatch;
     const std::string_view name = tableName(kind);
     out = RecordView{};
@@ -251,7 +271,7 @@ bool lookupRecordChecked(ThreadState& ts, const Site& site, ProgramEntry::Kind k
     }
     bool isNull = false;
     const ProgramEntry* entry = ds.pipeline->resolve(bytes, isNull);
-    if (isNull) return true;  // REC-8: nothing runs for this purpose
+    if (isNull) return remember();  // REC-8: nothing runs for this purpose
     if (!entry) {
         auto b = diag("REC-8", "the " + std::string(name) + " record holds an identifier that is not an export of the bound state object '" +
                                    ds.pipeline->name() + "': it is " + StateObject::describeForeignIdentifier(bytes));
@@ -310,7 +330,7 @@ bool lookupRecordChecked(ThreadState& ts, const Site& site, ProgramEntry::Kind k
     out.argumentsWritten = buffer->written.data() + (out.address - buffer->base) + kShaderIdentifierSizeInBytes;
     out.argumentBytesAvailable = std::min<uint64_t>(available, buffer->size() - (out.address - buffer->base)) -
                                  kShaderIdentifierSizeInBytes;
-    return true;
+    return remember();
 }
 
 bool lookupRecord(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
@@ -497,15 +517,23 @@ bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attrib
     candidate.attributeType = type;
     std::memcpy(candidate.attributes, attributes, type.size);
 
+    // IS-10: the search has ended, and so does the shader: by unwinding, or by its promised return.
+    auto endShader = [&] {
+        if (inv.shader->reportHitEnd == ReportHitEnd::Return && ts.dispatch->options.specialise) {
+            inv.searchEnded = true;
+            return true;
+        }
+        throw EndSearchSignal{};
+    };
     if (!inv.candidateOpaque && group.anyHit) {  // IS-7: the AHS runs inside ReportHit
         switch (runAnyHit(ts, rs, *inv.record, candidate)) {
             case AnyHitOutcome::Ignore: return false;
-            case AnyHitOutcome::AcceptAndEnd: commit(ts, rs, candidate); throw EndSearchSignal{};
+            case AnyHitOutcome::AcceptAndEnd: commit(ts, rs, candidate); return endShader();
             case AnyHitOutcome::Accept: break;
         }
     }
     commit(ts, rs, candidate);  // IS-6
-    if (rs.effectiveFlags & RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH) throw EndSearchSignal{};  // FLAG-8
+    if (rs.effectiveFlags & RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH) return endShader();  // FLAG-8
     return true;
 }
 
@@ -634,6 +662,7 @@ void processProcedural(ThreadState& ts, RayState& rs, const Candidate& c, const 
     checkGlobalSignature(ts, siteOf(inv), *record.entry);
     try {
         invoke(ts, inv, nullptr, nullptr);
+        if (inv.searchEnded) rs.searchEnded = true;  // ReportHitEnd::Return: the IS returned after it
     } catch (const EndSearchSignal&) {
         rs.searchEnded = true;  // IS-6/IS-7/FLAG-8: the IS ended at the accepting ReportHit
     }
@@ -1041,9 +1070,22 @@ void ShaderContext::stageViolation(const char* intrinsic) const {
                                  " shader");
 }
 
-uvec3 ShaderContext::DispatchRaysIndex() const { return inv_.thread->launchIndex; }
+void ShaderContext::calledAfterSearchEnded(const char* intrinsic) const {
+    // `intrinsic` is an intrinsic's name ("RayTCurrent") or a description ("a memory read").
+    std::string what = intrinsic;
+    if (what.find(' ') == std::string::npos) what += "()";
+    stageError(inv_, "IS-10", "intersection shader '" + inv_.shader->name + "' is registered with ReportHitEnd::Return " +
+                                  "(each ReportHit is its last action) but used " + what +
+                                  " after a ReportHit that ended the search");
+}
+
+uvec3 ShaderContext::DispatchRaysIndex() const {
+    requireLive("DispatchRaysIndex");
+    return inv_.thread->launchIndex;
+}
 
 uvec3 ShaderContext::DispatchRaysDimensions() const {
+    requireLive("DispatchRaysDimensions");
     const DispatchRaysDesc& d = *inv_.dispatch->desc;
     return {d.Width, d.Height, d.Depth};
 }
@@ -1091,6 +1133,7 @@ void ShaderContext::AcceptHitAndEndSearch() {
 
 void ShaderContext::traceRay(GpuVirtualAddress as, uint32_t flags, uint32_t mask, uint32_t r, uint32_t m, uint32_t miss,
                              const RayDesc& ray, void* payload, TypeTag payloadType) {
+    requireLive("TraceRay");
     if (!(bit(inv_.stage) & (bit(ShaderStage::RayGeneration) | bit(ShaderStage::ClosestHit) | bit(ShaderStage::Miss))))
         stageError(inv_, "RAY-2", "TraceRay() may not be called from a " + std::string(toString(inv_.stage)) + " shader");
     // Timed here rather than inside detail::traceRay: a cleanup there would lengthen the unwind table that
@@ -1100,6 +1143,7 @@ void ShaderContext::traceRay(GpuVirtualAddress as, uint32_t flags, uint32_t mask
 }
 
 void ShaderContext::callShader(uint32_t index, void* parameters, TypeTag type) {
+    requireLive("CallShader");
     if (!(bit(inv_.stage) & (bit(ShaderStage::RayGeneration) | bit(ShaderStage::ClosestHit) | bit(ShaderStage::Miss) |
                              bit(ShaderStage::Callable))))
         stageError(inv_, "CALL-2", "CallShader() may not be called from a " + std::string(toString(inv_.stage)) + " shader");
@@ -1107,6 +1151,29 @@ void ShaderContext::callShader(uint32_t index, void* parameters, TypeTag type) {
 }
 
 const uint8_t* ShaderContext::rootArgument(bool local, uint32_t parameter, size_t size, TypeTag type) const {
+    requireLive(local ? "a local root argument read" : "a global root argument read");
+    // Arguments that passed rootArgumentChecked's checks pass them again (LookupCache): the same argument bytes
+    // (those of one record, or the dispatch's global ones), parameter, size and type.
+    const uint8_t* bytes = nullptr;
+    uint64_t available = 0;
+    if (local) {
+        if (inv_.record) {
+            bytes = inv_.record->arguments;
+            available = inv_.record->argumentBytesAvailable;
+        }
+    } else if (inv_.dispatch->global) {
+        bytes = inv_.dispatch->global->bytes().data();
+        available = inv_.dispatch->global->bytes().size();
+    }
+    const detail::LookupCache::RootArgument& cached =
+        inv_.thread->lookups.rootArguments[detail::LookupCache::rootArgumentSlot(bytes, parameter)];
+    if (bytes && cached.arguments == bytes && cached.available == available && cached.parameter == parameter &&
+        cached.size == size && cached.type == type.id)
+        return cached.bytes;
+    return rootArgumentChecked(local, parameter, size, type);
+}
+
+const uint8_t* ShaderContext::rootArgumentChecked(bool local, uint32_t parameter, size_t size, TypeTag type) const {
     const RootSignature* signature = nullptr;
     const uint8_t* bytes = nullptr;
     const uint8_t* written = nullptr;
@@ -1150,6 +1217,8 @@ const uint8_t* ShaderContext::rootArgument(bool local, uint32_t parameter, size_
     if (std::memchr(written + offset, 0, size))
         stageError(inv_, "REC-7", std::string("shader reads ") + which + " root parameter " + std::to_string(parameter) +
                                       " of '" + signature->name() + "', whose bytes were never written");
+    inv_.thread->lookups.rootArguments[detail::LookupCache::rootArgumentSlot(bytes, parameter)] = {
+        bytes, available, parameter, uint32_t(size), type.id, bytes + offset};
     return bytes + offset;
 }
 

@@ -227,9 +227,16 @@ private:
                                     detail::stageBit(ShaderStage::ClosestHit);
 
     void requireStage(uint8_t allowed, const char* intrinsic) const {
+        requireLive(intrinsic);
         if (!(allowed & bit(inv_.stage))) stageViolation(intrinsic);
     }
     [[noreturn]] void stageViolation(const char* intrinsic) const;
+    // ReportHitEnd::Return: nothing may follow a ReportHit that ended the search (IS-10).
+    void requireLive(const char* intrinsic) const {
+        if (inv_.searchEnded) [[unlikely]]
+            calledAfterSearchEnded(intrinsic);
+    }
+    [[noreturn]] void calledAfterSearchEnded(const char* intrinsic) const;
     const detail::RayState& rayState(uint8_t allowed, const char* intrinsic) const {
         requireStage(allowed, intrinsic);
         return *inv_.ray;
@@ -243,6 +250,7 @@ private:
                   const RayDesc& ray, void* payload, TypeTag payloadType);
     void callShader(uint32_t index, void* parameters, TypeTag type);
     const uint8_t* rootArgument(bool local, uint32_t parameter, size_t size, TypeTag type) const;
+    const uint8_t* rootArgumentChecked(bool local, uint32_t parameter, size_t size, TypeTag type) const;
     const uint8_t* readMemory(GpuVirtualAddress address, uint64_t size) const;
     void readBufferView(GpuDescriptorHandle tableHandle, uint32_t offset, uint64_t byteOffset, uint64_t size,
                         void* out) const;

@@ -15,7 +15,11 @@ namespace refray::dxr {
 using detail::stageError;
 
 const uint8_t* ShaderContext::readMemory(GpuVirtualAddress address, uint64_t size) const {
-    try {
+    requireLive("a memory read");
+    if (const GpuBuffer* buffer =
+            detail::lookupCache(inv_).findBuffer(*inv_.dispatch->memory, address, std::max<uint64_t>(size, 1)))
+        return buffer->bytes.data() + (address - buffer->base);
+    try {  // outside every buffer: GpuMemory::read says so
         return inv_.dispatch->memory->read(address, size, "shader memory read");
     } catch (const Error& e) {
         stageError(inv_, "GEN-1", e.what());
@@ -23,6 +27,7 @@ const uint8_t* ShaderContext::readMemory(GpuVirtualAddress address, uint64_t siz
 }
 
 Image& ShaderContext::rwTexture2D(GpuDescriptorHandle tableHandle, uint32_t offset) const {
+    requireLive("RWTexture2D");
     const DescriptorHeap* heap = inv_.dispatch->device->findDescriptorHeap(tableHandle);
     if (!heap) stageError(inv_, "GEN-1", "descriptor handle is not in any descriptor heap");
     const Descriptor& d = heap->at(tableHandle, offset);
@@ -35,6 +40,7 @@ Image& ShaderContext::rwTexture2D(GpuDescriptorHandle tableHandle, uint32_t offs
 
 void ShaderContext::readBufferView(GpuDescriptorHandle tableHandle, uint32_t offset, uint64_t byteOffset, uint64_t size,
                                    void* out) const {
+    requireLive("a buffer view read");
     const DescriptorHeap* heap = inv_.dispatch->device->findDescriptorHeap(tableHandle);
     if (!heap) stageError(inv_, "GEN-1", "descriptor handle is not in any descriptor heap");
     const Descriptor& d = heap->at(tableHandle, offset);
@@ -94,6 +100,7 @@ void ShaderContext::bindingError(const char* rule, const BoundResource& bound, c
 
 BoundResource ShaderContext::resolve(DescriptorRangeType type, uint32_t shaderRegister, uint32_t space,
                                      uint32_t arrayIndex, const char* hlslType) const {
+    requireLive(hlslType);
     BoundResource r;
     r.hlslType = hlslType;
     r.type = type;

@@ -40,6 +40,19 @@ TypeTag typeTag() {
 // were checked against the export's declared TypeTags before the call.
 using ErasedShader = std::function<void(ShaderContext&, void* payload, const void* attributes)>;
 
+// How an intersection shader ends when one of its ReportHit calls ends the search (IS-10: FLAG-8, or an any-hit
+// shader's AcceptHitAndEndSearch). docs/emulator.md, "Ending an intersection shader".
+enum class ReportHitEnd : uint8_t {
+    // ReportHit does not return: an exception unwinds the shader back to traversal, so no code after the call runs.
+    // Right for every shader; costs a C++ unwind (tens of thousands of instructions) per ended search.
+    Unwind,
+    // ReportHit returns true and the shader returns by itself. The shader promises that each ReportHit it makes is
+    // its last action, as in HLSL's `if (hit) ReportHit(t, kind, attr); }`. Every ported intersection shader is
+    // written that way. An intrinsic called after the search ended breaks the promise: an IS-10 error stops the
+    // dispatch. DispatchOptions::specialise = false unwinds these shaders too.
+    Return,
+};
+
 struct ShaderExport {
     std::string name;
     ShaderStage stage = ShaderStage::RayGeneration;
@@ -47,6 +60,7 @@ struct ShaderExport {
     TypeTag attributes;  // IS (what it reports), AHS, CHS
     TypeTag parameters;  // callable
     ErasedShader function;
+    ReportHitEnd reportHitEnd = ReportHitEnd::Unwind;  // IS
 };
 
 // A DXIL library: named shader exports. Signatures mirror HLSL entry points:
@@ -56,9 +70,10 @@ class ShaderLibrary {
 public:
     void addRayGeneration(std::string name, std::function<void(ShaderContext&)> fn);
     template <class Attributes>
-    void addIntersection(std::string name, std::function<void(ShaderContext&)> fn) {
+    void addIntersection(std::string name, std::function<void(ShaderContext&)> fn,
+                         ReportHitEnd end = ReportHitEnd::Unwind) {
         add({std::move(name), ShaderStage::Intersection, {}, typeTag<Attributes>(), {},
-             [fn = std::move(fn)](ShaderContext& c, void*, const void*) { fn(c); }});
+             [fn = std::move(fn)](ShaderContext& c, void*, const void*) { fn(c); }, end});
     }
     template <class Payload, class Attributes>
     void addAnyHit(std::string name, std::function<void(ShaderContext&, Payload&, const Attributes&)> fn) {

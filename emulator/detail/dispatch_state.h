@@ -2,6 +2,7 @@
 // emulator: dispatcher.cpp runs the dispatch, shader_resources.cpp serves the resource intrinsics from it.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <string>
@@ -23,6 +24,60 @@ struct DispatchState {
     bool anyHitInPipeline = false;  // a hit group of the pipeline names an any-hit shader
     std::atomic<uint64_t> firstErrorIndex{~0ull};
 };
+
+// Lookups a dispatch repeats with the same answer, remembered per worker thread. While a dispatch runs its shader
+// tables are locked (REC-12), its global root arguments are fixed and no GPU buffer comes or goes, so a lookup that
+// succeeded once succeeds again with the same result. Only successes are kept: every failure still goes through
+// the full check and its diagnostic. Each dispatch starts with an empty cache.
+struct LookupCache {
+    // The buffers read last, most recent first: shaders read a handful of buffers over and over.
+    std::array<const GpuBuffer*, 4> buffers{};
+    // The buffer holding [va, va + n): from the cache, else from `memory` (then cached); nullptr if none holds it.
+    const GpuBuffer* findBuffer(const GpuMemory& memory, GpuVirtualAddress va, uint64_t n) {
+        for (size_t i = 0; i < buffers.size(); ++i)
+            if (buffers[i] && buffers[i]->contains(va, n)) {
+                const GpuBuffer* hit = buffers[i];
+                for (; i > 0; --i) buffers[i] = buffers[i - 1];
+                return buffers[0] = hit;
+            }
+        const GpuBuffer* found = memory.find(va, n);
+        if (found) {
+            for (size_t i = buffers.size() - 1; i > 0; --i) buffers[i] = buffers[i - 1];
+            buffers[0] = found;
+        }
+        return found;
+    }
+
+    // Root arguments that passed ShaderContext::rootArgument's checks: the argument bytes they were read from (a
+    // record's, or the dispatch's global ones), the parameter, size and type, and the checked pointer.
+    struct RootArgument {
+        const uint8_t* arguments = nullptr;
+        uint64_t available = 0;  // the argument bytes the record's table leaves it
+        uint32_t parameter = 0;
+        uint32_t size = 0;
+        const void* type = nullptr;
+        const uint8_t* bytes = nullptr;
+    };
+    std::array<RootArgument, 64> rootArguments{};
+    static size_t rootArgumentSlot(const uint8_t* arguments, uint32_t parameter) {
+        return (reinterpret_cast<uintptr_t>(arguments) / 8 * 31 + parameter) % 64;
+    }
+
+    // Records that passed lookupRecordChecked: the table, kind, index and (hit groups) geometry type they were
+    // checked for.
+    struct Record {
+        GpuVirtualAddressRangeAndStride table{};
+        uint64_t index = ~0ull;
+        uint8_t kind = 0;
+        uint8_t geometry = 0;  // 0: no hit; 1 + GeometryType otherwise
+        RecordView view;
+    };
+    std::array<Record, 128> records{};
+    static size_t recordSlot(uint64_t index, uint8_t kind) { return (index * 4 + kind) % 128; }
+};
+
+// The calling worker thread's LookupCache.
+LookupCache& lookupCache(Invocation& inv);
 
 // Stops the invocation with a DxrError carrying `rule`, the stage and the launch site: misuse of the shader API
 // always stops, there is no fallback.

@@ -68,6 +68,7 @@ struct Invocation {
     ThreadState* thread = nullptr;
     uint32_t depth = 0;
     bool candidateOpaque = true;  // IS: the OPQ-1 opacity of the box, which ReportHit applies
+    bool searchEnded = false;     // IS with ReportHitEnd::Return: a ReportHit ended the search; no intrinsic may follow
 };
 
 }  // namespace refray::dxr::detail

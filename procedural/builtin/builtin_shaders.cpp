@@ -142,7 +142,7 @@ std::shared_ptr<ShaderLibrary> makeShaderLibrary(SecondaryRayOrigin mode) {
         float t;
         if (intersectSphere(o, d, radius, ctx.RayTMin(), ctx.RayTCurrent(), t))
             ctx.ReportHit(t, 0, SphereAttributes{(o + t * d) / radius});
-    });
+    }, ReportHitEnd::Return);  // the ReportHit is its last action
 
     lib->addClosestHit<RadiancePayload, SphereAttributes>(
         "ClosestHit_Sphere", [mode](ShaderContext& ctx, RadiancePayload& payload, const SphereAttributes& attr) {

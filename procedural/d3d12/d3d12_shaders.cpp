@@ -494,15 +494,20 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
         });
     lib.addMiss<RayPayload>("MyMissShader", MyMissShader);
     lib.addMiss<ShadowRayPayload>("MyMissShader_ShadowRay", MyMissShader_ShadowRay);
+    // Each intersection shader's ReportHit is its last action, as in the HLSL: ReportHitEnd::Return spares the unwind
+    // when a shadow ray's hit ends the search (docs/emulator.md, "Ending an intersection shader").
     lib.addIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_AnalyticPrimitive",
-        [](ShaderContext& ctx) { MyIntersectionShader_AnalyticPrimitive<T>(ctx); });
+        [](ShaderContext& ctx) { MyIntersectionShader_AnalyticPrimitive<T>(ctx); },
+        ReportHitEnd::Return);
     lib.addIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_VolumetricPrimitive",
-        [accuracy](ShaderContext& ctx) { MyIntersectionShader_VolumetricPrimitive<T>(ctx, accuracy); });
+        [accuracy](ShaderContext& ctx) { MyIntersectionShader_VolumetricPrimitive<T>(ctx, accuracy); },
+        ReportHitEnd::Return);
     lib.addIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_SignedDistancePrimitive",
-        [accuracy](ShaderContext& ctx) { MyIntersectionShader_SignedDistancePrimitive<T>(ctx, accuracy); });
+        [accuracy](ShaderContext& ctx) { MyIntersectionShader_SignedDistancePrimitive<T>(ctx, accuracy); },
+        ReportHitEnd::Return);
 }
 
 }  // namespace

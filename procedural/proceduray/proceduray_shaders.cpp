@@ -601,15 +601,19 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
                                                              const BuiltInTriangleIntersectionAttributes& attr) {
             ClosestHit_Triangle<T>(ctx, traceRay, accuracy, effects, payload, attr);
         });
+    // Each intersection shader below ends with its ReportHit (the debug-flag path returns right after it), as in
+    // the HLSL: ReportHitEnd::Return (docs/emulator.md, "Ending an intersection shader").
     lib.addIntersection<ProceduralPrimitiveAttributes>(
-        "Intersection_Julia", [accuracy](ShaderContext& ctx) { Intersection_Julia<T>(ctx, accuracy); });
+        "Intersection_Julia", [accuracy](ShaderContext& ctx) { Intersection_Julia<T>(ctx, accuracy); },
+        ReportHitEnd::Return);
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Julia",
         [traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
             ClosestHit_Julia<T>(ctx, traceRay, accuracy, payload, attr);
         });
     lib.addIntersection<ProceduralPrimitiveAttributes>(
-        "Intersection_Pacman", [accuracy](ShaderContext& ctx) { Intersection_Pacman<T>(ctx, accuracy); });
+        "Intersection_Pacman", [accuracy](ShaderContext& ctx) { Intersection_Pacman<T>(ctx, accuracy); },
+        ReportHitEnd::Return);
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Pacman",
         [traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
@@ -617,7 +621,8 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
             ClosestHit_Pacman<T>(ctx, traceRay, accuracy, effects, payload, attr);
         });
     lib.addIntersection<ProceduralPrimitiveAttributes>(
-        "Intersection_Mandelbulb", [accuracy](ShaderContext& ctx) { Intersection_Mandelbulb<T>(ctx, accuracy); });
+        "Intersection_Mandelbulb", [accuracy](ShaderContext& ctx) { Intersection_Mandelbulb<T>(ctx, accuracy); },
+        ReportHitEnd::Return);
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Mandelbulb",
         [traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {

@@ -55,6 +55,8 @@ bool contains(const std::string& s, const std::string& part) { return s.find(par
 //   HG_Tri {CH_Probe}, HG_TriAH {AH_Probe, CH_Probe}, HG_Box {IS_Box, CH_ProbeAABB} (harness)
 //   HG_TriS {AH_TriS, CH_TriS}, HG_TriS_noAH {CH_TriS}, HG_TriS_noCH {AH_TriS}
 //   HG_BoxS {IS_S, AH_BoxS, CH_BoxS}, HG_BoxS_noAH {IS_S, CH_BoxS}
+//   HG_BoxR {IS_R, AH_BoxS, CH_BoxS}, HG_BoxR_noAH {IS_R, CH_BoxS}: IS_R runs the IS_S script but is registered
+//   with ReportHitEnd::Return
 // Miss shaders: Miss_Probe (harness), Miss_S. Callable: CL_S (CallParams).
 struct Rig {
     Harness h;
@@ -93,14 +95,16 @@ struct Rig {
             result = p;
             traced = true;
         });
-        lib.addIntersection<ProbeAttributes>("IS_S", [this](ShaderContext& ctx) {
+        const auto intersection = [this](ShaderContext& ctx) {
             isCalls++;
             if (log) events.push_back("IS");
             if (is) return is(ctx);
             auto slab = intersectAABB(ctx.ObjectRayOrigin(), ctx.ObjectRayDirection(), unitBox(), ctx.RayTMin(),
                                       ctx.RayTCurrent());
             if (slab) ctx.ReportHit(slab->tEnter, isKind, ProbeAttributes{slab->tEnter});
-        });
+        };
+        lib.addIntersection<ProbeAttributes>("IS_S", intersection);
+        lib.addIntersection<ProbeAttributes>("IS_R", intersection, ReportHitEnd::Return);
         lib.addAnyHit<Probe, BuiltInTriangleIntersectionAttributes>(
             "AH_TriS", [this](ShaderContext& ctx, Probe& p, const BuiltInTriangleIntersectionAttributes& a) {
                 p.anyHits++;
@@ -140,6 +144,8 @@ struct Rig {
         hg.push_back({"HG_TriS_noCH", HitGroupType::Triangles, "AH_TriS", "", ""});
         hg.push_back({"HG_BoxS", HitGroupType::ProceduralPrimitive, "AH_BoxS", "CH_BoxS", "IS_S"});
         hg.push_back({"HG_BoxS_noAH", HitGroupType::ProceduralPrimitive, "", "CH_BoxS", "IS_S"});
+        hg.push_back({"HG_BoxR", HitGroupType::ProceduralPrimitive, "AH_BoxS", "CH_BoxS", "IS_R"});
+        hg.push_back({"HG_BoxR_noAH", HitGroupType::ProceduralPrimitive, "", "CH_BoxS", "IS_R"});
     }
     Rig(const Rig&) = delete;
     Rig& operator=(const Rig&) = delete;
@@ -1261,6 +1267,80 @@ TEST(Dispatcher, IS_10_CodeAfterTerminatingReportHitNeverRuns) {
     EXPECT_EQ(r.result.closestHits, 1u);
     EXPECT_EQ(r.result.t, 8.0f);
     EXPECT_EQ(r.result.hitKind, 1u);
+}
+
+// ReportHitEnd::Return: the shader promises its ReportHit is its last action, so an ending ReportHit returns true
+// instead of unwinding. Everything DXR defines comes out as with the unwind; a broken promise is an IS-10 error.
+TEST(Dispatcher, IS_10_ReturnDeclaredShaderEndsTheSearchWithoutUnwinding) {
+    Rig r;
+    const auto box = r.h.blas({r.h.aabbs({unitBox()}, GEOMETRY_FLAG_NONE)});  // non-opaque: the AHS runs
+    // Two boxes on the ray: entries at t = 4 and t = 7.
+    r.h.tlas({Harness::instance(box), Harness::instance(box, 0, Matrix3x4::translation({0, 0, 3}))});
+    std::vector<bool> results;
+    r.is = [&](ShaderContext& ctx) {
+        auto slab = intersectAABB(ctx.ObjectRayOrigin(), ctx.ObjectRayDirection(), unitBox(), ctx.RayTMin(),
+                                  ctx.RayTCurrent());
+        if (slab) results.push_back(ctx.ReportHit(slab->tEnter, 3, ProbeAttributes{slab->tEnter}));
+    };
+    r.args.flags = RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH;  // FLAG-8
+    for (const char* group : {"HG_BoxS_noAH", "HG_BoxR_noAH"}) {
+        SCOPED_TRACE(group);
+        results.clear();
+        r.run({group});
+        EXPECT_EQ(r.isCalls, 1);  // the search ended at the first box
+        EXPECT_EQ(r.result.closestHits, 1u);
+        EXPECT_EQ(r.result.t, 4.0f);
+        EXPECT_EQ(r.result.hitKind, 3u);
+        // Unwound, the call never returns; declared, it returns true.
+        EXPECT_EQ(results, std::string(group) == "HG_BoxR_noAH" ? std::vector<bool>{true} : std::vector<bool>{});
+    }
+    // An any-hit shader's AcceptHitAndEndSearch inside ReportHit ends the IS the same way.
+    r.args.flags = RAY_FLAG_NONE;
+    r.ahBox = [](ShaderContext& ctx, Probe&, const ProbeAttributes&) { ctx.AcceptHitAndEndSearch(); };
+    results.clear();
+    r.run({"HG_BoxR"});
+    EXPECT_EQ(results, std::vector<bool>{true});
+    EXPECT_EQ(r.isCalls, 1);
+    EXPECT_EQ(r.result.anyHits, 1u);
+    EXPECT_EQ(r.result.t, 4.0f);
+    // With the shortcuts off the declaration is ignored: the call unwinds.
+    DispatchOptions plain;
+    plain.specialise = false;
+    results.clear();
+    r.run({"HG_BoxR"}, uvec3(1u), plain);
+    EXPECT_TRUE(results.empty());
+    EXPECT_EQ(r.isCalls, 1);
+    EXPECT_EQ(r.result.t, 4.0f);
+}
+
+TEST(Dispatcher, IS_10_ReturnDeclaredShaderUsingAnIntrinsicAfterTheEndIsAnError) {
+    Rig r;
+    r.h.tlas({Harness::instance(r.h.blas({r.h.aabbs({unitBox()})}))});
+    r.args.flags = RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH;
+    struct Case {
+        const char* what;
+        std::function<void(ShaderContext&)> after;
+    };
+    const std::vector<Case> cases = {
+        {"RayTCurrent()", [](ShaderContext& ctx) { (void)ctx.RayTCurrent(); }},
+        {"ReportHit()", [](ShaderContext& ctx) { ctx.ReportHit(6.0f, 0, ProbeAttributes{}); }},
+        {"DispatchRaysIndex()", [](ShaderContext& ctx) { (void)ctx.DispatchRaysIndex(); }},
+        {"a global root argument read", [](ShaderContext& ctx) { (void)ctx.globalRootDescriptor(0); }},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.what);
+        r.is = [&](ShaderContext& ctx) {
+            ctx.ReportHit(8.0f, 1, ProbeAttributes{});
+            c.after(ctx);
+        };
+        const auto d = expectDxrError("IS-10", [&] { r.run({"HG_BoxR_noAH"}); });
+        EXPECT_TRUE(contains(d.message, "'IS_R'")) << d.format();
+        EXPECT_TRUE(contains(d.message, std::string("used ") + c.what + " after a ReportHit that ended the search"))
+            << d.format();
+        // Without the declaration the same script is fine: the unwind never lets it get there.
+        r.run({"HG_BoxS_noAH"});
+        EXPECT_EQ(r.result.t, 8.0f);
+    }
 }
 
 // ---------------------------------------------------------------------------------------

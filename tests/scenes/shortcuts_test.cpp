@@ -1,6 +1,8 @@
 // The traversal shortcuts on the reference scenes (DispatchOptions::specialise): the same image, bit for bit,
 // and the same ray-generation, closest-hit and miss invocations as gathering every candidate; shadow rays take the occlusion
-// query (neither library has an any-hit shader), every other ray the bounded gather.
+// query (neither library has an any-hit shader), every other ray the bounded gather. With the shortcuts, the ports'
+// intersection shaders also return from a ReportHit that ends the search (ReportHitEnd::Return) instead of unwinding,
+// so this also checks the ports keep that promise.
 #include <gtest/gtest.h>
 
 #include <cstring>
