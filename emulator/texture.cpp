@@ -87,14 +87,24 @@ void validateSamplerDesc(const SamplerDesc& desc, const std::string& where) {
 
 namespace {
 
-// One TextureSystem for every Texture2D of the process, made when the first texture is and destroyed with the last.
-// Private (not OpenImageIO's shared one), so nothing else in the process changes its settings.
+// One TextureSystem for every Texture2D of the process. Private (not OpenImageIO's shared one), so nothing else in
+// the process changes its settings. It is made with the first texture and lives as long as the process: OpenImageIO
+// 2.4's TextureSystem::destroy frees it through a mismatched sized delete (AddressSanitizer reports a
+// new-delete-type-mismatch inside libOpenImageIO). When the last texture goes, its caches are emptied instead, so
+// no file stays open or cached.
+OIIO::TextureSystem& processTextureSystem() {
+    static OIIO::TextureSystem* const system = [] {
+        OIIO::TextureSystem* ts = OIIO::TextureSystem::create(/*shared=*/false);
+        ts->attribute("automip", 1);            // a full MIP chain for files without one
+        ts->attribute("unassociatedalpha", 1);  // texels as stored: no premultiplication of PNG alpha
+        return ts;
+    }();
+    return *system;
+}
+
 struct TextureSystemOwner {
-    TextureSystemOwner() : system(OIIO::TextureSystem::create(/*shared=*/false)) {
-        system->attribute("automip", 1);            // a full MIP chain for files without one
-        system->attribute("unassociatedalpha", 1);  // texels as stored: no premultiplication of PNG alpha
-    }
-    ~TextureSystemOwner() { OIIO::TextureSystem::destroy(system); }
+    TextureSystemOwner() : system(&processTextureSystem()) {}
+    ~TextureSystemOwner() { system->invalidate_all(/*force=*/true); }
     TextureSystemOwner(const TextureSystemOwner&) = delete;
     TextureSystemOwner& operator=(const TextureSystemOwner&) = delete;
     OIIO::TextureSystem* system;

@@ -4,29 +4,47 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <sstream>
+#include <string_view>
 #include <unistd.h>
 
 #include "core/error.h"
 
 namespace refray::tools {
 
+namespace {
+
+// "<digits><separator><digits>", each number 1 to 9 digits: the two numbers, or false.
+bool parseNumberPair(const std::string& text, char separator, unsigned long& a, unsigned long& b) {
+    const size_t at = text.find(separator);
+    if (at == std::string::npos) return false;
+    const auto number = [](std::string_view digits, unsigned long& value) {
+        if (digits.empty() || digits.size() > 9) return false;
+        value = 0;
+        for (char c : digits) {
+            if (c < '0' || c > '9') return false;
+            value = value * 10 + unsigned(c - '0');
+        }
+        return true;
+    };
+    const std::string_view view(text);
+    return number(view.substr(0, at), a) && number(view.substr(at + 1), b);
+}
+
+}  // namespace
+
 Size parseSize(const std::string& text, const char* option) {
-    static const std::regex pattern(R"((\d{1,9})x(\d{1,9}))");
-    std::smatch m;
-    REFRAY_CHECK(std::regex_match(text, m, pattern), option << " expects WIDTHxHEIGHT (e.g. 640x360), got '" << text << "'");
-    const unsigned long w = std::stoul(m[1]), h = std::stoul(m[2]);
+    unsigned long w = 0, h = 0;
+    REFRAY_CHECK(parseNumberPair(text, 'x', w, h), option << " expects WIDTHxHEIGHT (e.g. 640x360), got '" << text << "'");
     REFRAY_CHECK(w > 0 && h > 0 && w <= 16384 && h <= 16384, option << " " << text << " is outside 1x1 .. 16384x16384");
     return {uint32_t(w), uint32_t(h)};
 }
 
 void parsePixel(const std::string& text, uint32_t& x, uint32_t& y, const char* option) {
-    static const std::regex pattern(R"((\d{1,9}),(\d{1,9}))");
-    std::smatch m;
-    REFRAY_CHECK(std::regex_match(text, m, pattern), option << " expects X,Y (e.g. 640,360), got '" << text << "'");
-    x = uint32_t(std::stoul(m[1]));
-    y = uint32_t(std::stoul(m[2]));
+    unsigned long a = 0, b = 0;
+    REFRAY_CHECK(parseNumberPair(text, ',', a, b), option << " expects X,Y (e.g. 640,360), got '" << text << "'");
+    x = uint32_t(a);
+    y = uint32_t(b);
 }
 
 Progress::Sink terminalProgress() {

@@ -395,8 +395,8 @@ int main(int argc, char** argv) {
                      "With --stats or --stats-json: do not time the stages (their clocks cost a few per cent), for "
                      "timing the render itself");
     render->add_flag("--no-shortcuts", ro.noShortcuts,
-                     "Gather every candidate of every ray: no traversal shortcuts (for measuring them; the image is "
-                     "the same)");
+                     "Gather every candidate of every ray and unwind every intersection shader whose ReportHit ends "
+                     "the search: no shortcuts (for measuring them; the image is the same)");
     render->add_option("--aov", ro.aov,
                        "Write an index map instead of the render: record|instance|geometry|primitive|hitgroup|depth "
                        "of each pixel's primary ray, false-coloured, with a legend");
