@@ -224,6 +224,33 @@ Effect cullingEffect(const SceneDesc& scene, const ShaderLibraryFacts& facts, co
     return effect(name, true, reason);
 }
 
+// geometrySkipPipelineFlags, with the reason. `triangles` and `procedural` are the geometry effects.
+Effect geometrySkipEffect(const SceneDesc& scene, const ShaderLibraryFacts& facts, const Effect& triangles,
+                          const Effect& procedural, uint32_t& flags) {
+    const char* name = "geometry-skipping pipeline flag";
+    flags = dxr::PIPELINE_FLAG_NONE;
+    if (triangles.on == procedural.on)
+        return effect(name, false, triangles.on ? "rays reach both triangle and AABB geometry"
+                                                : "rays reach no geometry at all");
+    // FLAG-4/5 on the effective flags: SKIP_TRIANGLES excludes CULL_*_FACING_TRIANGLES and SKIP_PROCEDURAL_PRIMITIVES;
+    // SKIP_PROCEDURAL_PRIMITIVES excludes SKIP_TRIANGLES.
+    const uint32_t candidate = triangles.on ? dxr::PIPELINE_FLAG_SKIP_PROCEDURAL_PRIMITIVES : dxr::PIPELINE_FLAG_SKIP_TRIANGLES;
+    const uint32_t excluded = triangles.on ? dxr::RAY_FLAG_SKIP_TRIANGLES
+                                           : dxr::RAY_FLAG_CULL_BACK_FACING_TRIANGLES |
+                                                 dxr::RAY_FLAG_CULL_FRONT_FACING_TRIANGLES |
+                                                 dxr::RAY_FLAG_SKIP_PROCEDURAL_PRIMITIVES;
+    for (size_t r = 0; r < scene.rayTypes.size() && r < facts.rayFlags.size(); ++r)
+        if (facts.rayFlags[r] & excluded)
+            return effect(name, false,
+                          concat("pipeline flag ", dxr::pipelineFlagsToString(candidate), " would be undefined with the ",
+                                 dxr::rayFlagsToString(facts.rayFlags[r] & excluded), " of ray type ",
+                                 inQuotes(scene.rayTypes[r].name), " (FLAG-4, FLAG-5)"));
+    flags = candidate;
+    return effect(name, true,
+                  concat("pipeline flag ", dxr::pipelineFlagsToString(candidate), ": no instance a ray can reach holds ",
+                         triangles.on ? "AABB" : "triangle", " geometry"));
+}
+
 std::string depthSource(const SceneDesc& scene, const procedural::Accuracy& knobs) {
     if (knobs.maxRecursionDepth) return "the recursion-depth knob";
     if (scene.effects.reflectionDepth) return "the scene's reflectionDepth";
@@ -273,8 +300,8 @@ Effect textureEffect(const SceneDesc& scene, const ShaderLibraryFacts& facts, Sh
 }  // namespace
 
 std::vector<Effect> EffectSet::list() const {
-    return {triangles,     procedural,  anyHit,      triangleCulling,  shadowRays,   reflections, animation,
-            supersampling, distanceFog, rayDifferentials, debugColours, textures, normalMaps};
+    return {triangles,   procedural,    anyHit,      triangleCulling,  geometrySkip, shadowRays, reflections,
+            animation,   supersampling, distanceFog, rayDifferentials, debugColours, textures,   normalMaps};
 }
 
 procedural::Accuracy libraryAccuracy(const SceneDesc& scene, const procedural::Accuracy& knobs) {
@@ -324,6 +351,7 @@ EffectSet computeEffects(const SceneDesc& scene, const RenderSettings& settings)
     e.procedural = geometryEffect(scene, dxr::GeometryType::ProceduralPrimitiveAABBs, "procedural primitives", "AABB");
     e.anyHit = anyHitEffect(scene);
     e.triangleCulling = cullingEffect(scene, facts, e.triangles);
+    e.geometrySkip = geometrySkipEffect(scene, facts, e.triangles, e.procedural, e.pipelineFlags);
 
     // Shadow rays: traced by closest hits at depth d < MAX_RAY_RECURSION_DEPTH, unless switched off.
     {
@@ -497,6 +525,15 @@ EffectSet computeEffects(const SceneDesc& scene, const RenderSettings& settings)
     e.normalMaps = textureEffect(scene, facts, ShaderEffect::NormalMaps, "normal maps", "perturbs normals with",
                                  "normal map", "normal maps", "norm, map_Bump");
     return e;
+}
+
+uint32_t geometrySkipPipelineFlags(const SceneDesc& scene) {
+    uint32_t flags = dxr::PIPELINE_FLAG_NONE;
+    geometrySkipEffect(scene, findShaderLibrary(scene.shaderLibrary).facts,
+                       geometryEffect(scene, dxr::GeometryType::Triangles, "triangles", "triangle"),
+                       geometryEffect(scene, dxr::GeometryType::ProceduralPrimitiveAABBs, "procedural primitives", "AABB"),
+                       flags);
+    return flags;
 }
 
 std::string describeEffects(const EffectSet& effects) {

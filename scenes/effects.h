@@ -29,6 +29,7 @@ struct EffectSet {
     Effect procedural;        // AABB geometry (intersection shaders) in a BLAS an instance holds
     Effect anyHit;            // an any-hit shader in a hit group a record references
     Effect triangleCulling;   // a ray type culls back- or front-facing triangles on an instance that allows it
+    Effect geometrySkip;      // a pipeline flag (PIPE-3) skips the geometry type no ray can reach (pipelineFlags)
     Effect shadowRays;        // closest hits trace the shadow ray type (not switched off, depth allows)
     Effect reflections;       // closest hits trace reflection rays (MAX_RAY_RECURSION_DEPTH >= 2)
     Effect animation;         // a shader reads elapsedTime or a generated buffer moves with the time
@@ -43,6 +44,8 @@ struct EffectSet {
     // The pipeline's MaxTraceRecursionDepth (at least recursionDepth).
     uint32_t pipelineRecursionDepth = 0;
     uint32_t spp = 1;
+    // The pipeline's flags: PIPELINE_FLAG_SKIP_TRIANGLES or _SKIP_PROCEDURAL_PRIMITIVES when geometrySkip is on.
+    uint32_t pipelineFlags = 0;
 
     // Every effect, in the order of the members above.
     std::vector<Effect> list() const;
@@ -51,6 +54,12 @@ struct EffectSet {
 // The effects of `scene` rendered with `settings` (its spp and recursion-depth knob count; camera, size and time do
 // not change what is simulated). Throws refray::Error for an unknown shader library.
 EffectSet computeEffects(const SceneDesc& scene, const RenderSettings& settings = {});
+
+// The pipeline flags (PIPE-3, Tier 1.1) that skip the one geometry type no ray of `scene` can reach:
+// PIPELINE_FLAG_SKIP_TRIANGLES without triangles, _SKIP_PROCEDURAL_PRIMITIVES without AABBs. None when the scene
+// reaches both types or neither, or when a ray type's TraceRay flags would make the pair undefined (FLAG-4, FLAG-5).
+// Scene's pipelines are built with them. They change no result: a skipped type has nothing to skip.
+uint32_t geometrySkipPipelineFlags(const SceneDesc& scene);
 
 // One line per effect, the simulated ones first: "simulated: NAME - REASON" or "skipped: NAME - REASON".
 std::string describeEffects(const EffectSet& effects);

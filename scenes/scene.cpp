@@ -186,7 +186,8 @@ Scene::Pipeline& Scene::pipelineFor(const LibraryOptions& options) {
     so.shaderConfigs = {{desc_.maxPayloadBytes, desc_.maxAttributeBytes}};
     // PORT: a recursion-depth knob is the shaders and the host recompiled with another MAX_RAY_RECURSION_DEPTH, so
     // the pipeline allows at least that depth.
-    so.pipelineConfigs = {{pipelineRecursionDepth(desc_, accuracy), PIPELINE_FLAG_NONE}};
+    // The pipeline flag that skips a geometry type no ray reaches, where the ray flags allow it (scenes/effects.h).
+    so.pipelineConfigs = {{pipelineRecursionDepth(desc_, accuracy), geometrySkipPipelineFlags(desc_)}};
     Pipeline p;
     p.stateObject = StateObject::create(so);
 

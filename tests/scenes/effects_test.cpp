@@ -50,6 +50,7 @@ TEST(EffectSet, ProceduraySceneFieldByField) {
                  "none of the 8 hit groups the records name has an any-hit shader");
     expectEffect(e.triangleCulling, "triangle culling", true,
                  "'Radiance', 'Shadow' rays cull back-facing triangles of instance 'slab'");
+    expectEffect(e.geometrySkip, "geometry-skipping pipeline flag", false, "rays reach both triangle and AABB geometry");
     expectEffect(e.shadowRays, "shadow rays", true,
                  "ClosestHit_Triangle, ClosestHit_Pacman trace 'Shadow' rays towards the light from hits at depth "
                  "1..2, MAX_RAY_RECURSION_DEPTH 3 (the HLSL's)");
@@ -79,6 +80,8 @@ TEST(EffectSet, D3D12SceneFieldByField) {
                  "none of the 8 hit groups the records name has an any-hit shader");
     expectEffect(e.triangleCulling, "triangle culling", true,
                  "'Radiance', 'Shadow' rays cull back-facing triangles of instance 'ground'");
+    expectEffect(e.geometrySkip, "geometry-skipping pipeline flag", false, "rays reach both triangle and AABB geometry");
+    EXPECT_EQ(e.pipelineFlags, dxr::PIPELINE_FLAG_NONE);
     expectEffect(e.shadowRays, "shadow rays", true,
                  "MyClosestHitShader_Triangle, MyClosestHitShader_AABB trace 'Shadow' rays towards the light from "
                  "hits at depth 1..2, MAX_RAY_RECURSION_DEPTH 3 (the HLSL's)");
@@ -98,6 +101,30 @@ TEST(EffectSet, D3D12SceneFieldByField) {
     expectEffect(e.debugColours, "debug colours", false, "library 'd3d12-procedural-geometry' has no debugFlag");
     EXPECT_EQ(e.recursionDepth, 3u);
     EXPECT_EQ(e.pipelineRecursionDepth, 3u);
+}
+
+// A pipeline flag skips the geometry type no ray reaches, unless a ray type's flags make it undefined. The Cornell
+// box's pipeline gets SKIP_PROCEDURAL_PRIMITIVES; PathTracerSceneFile.* checks its render is bit-identical to the
+// C++-built twin, whose pipeline has no flags.
+TEST(EffectSet, GeometrySkippingPipelineFlag) {
+    const SceneDesc cornell = loadSceneFile(kSourceDir + "/scenes/cornell-box.json");
+    const EffectSet c = computeEffects(cornell);
+    expectEffect(c.geometrySkip, "geometry-skipping pipeline flag", true,
+                 "pipeline flag SKIP_PROCEDURAL_PRIMITIVES: no instance a ray can reach holds AABB geometry");
+    EXPECT_EQ(c.pipelineFlags, dxr::PIPELINE_FLAG_SKIP_PROCEDURAL_PRIMITIVES);
+    EXPECT_EQ(geometrySkipPipelineFlags(cornell), dxr::PIPELINE_FLAG_SKIP_PROCEDURAL_PRIMITIVES);
+    EXPECT_EQ(geometrySkipPipelineFlags(loadSceneFile(kD3D12)), dxr::PIPELINE_FLAG_NONE);
+
+    // The D3D12 scene without its ground: only AABBs, but its rays cull back faces, which SKIP_TRIANGLES excludes.
+    SceneDesc boxesOnly = loadSceneFile(kD3D12);
+    boxesOnly.instances.erase(std::remove_if(boxesOnly.instances.begin(), boxesOnly.instances.end(),
+                                             [](const InstanceDescFile& i) { return i.name == "ground"; }),
+                              boxesOnly.instances.end());
+    const EffectSet b = computeEffects(boxesOnly);
+    expectEffect(b.geometrySkip, "geometry-skipping pipeline flag", false,
+                 "pipeline flag SKIP_TRIANGLES would be undefined with the CULL_BACK_FACING_TRIANGLES of ray type "
+                 "'Radiance' (FLAG-4, FLAG-5)");
+    EXPECT_EQ(b.pipelineFlags, dxr::PIPELINE_FLAG_NONE);
 }
 
 TEST(EffectSet, DescribeListsSimulatedThenSkipped) {
