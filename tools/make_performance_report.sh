@@ -156,20 +156,21 @@ slowest=$d3d12
 a=$(seconds "$refray" $d3d12 640x360 2)
 b=$(seconds "$refray" $proceduray 640x360 2)
 awk -v a="$a" -v b="$b" 'BEGIN {exit !(b > a)}' && slowest=$proceduray
+# (awk, not head, ends the listings: head would close the pipe early, and pipefail would stop the script.)
 # Only DispatchRays is collected: the program's start (the dynamic loader binding OpenImageIO's codecs) would
 # otherwise dominate a small render.
-valgrind --tool=callgrind --callgrind-out-file="$work/profile.cg" --toggle-collect='refray::dxr::Device::dispatchRays*' \
+valgrind --tool=callgrind --callgrind-out-file="$work/profile.cg" --toggle-collect='*Device::dispatchRays*' \
   "$refray" render "$slowest" --size 320x180 --threads 1 -o "$work/image.exr" > /dev/null 2>&1
 {
   echo
   echo "### Profile: $(basename "$slowest" .json), 320x180, 1 thread (callgrind, DispatchRays only)"
   echo
   echo '```'
-  callgrind_annotate --inclusive=no "$work/profile.cg" 2> /dev/null | sed -n '/^Ir/,$p' | head -25 |
+  callgrind_annotate --inclusive=no "$work/profile.cg" 2> /dev/null | sed -n '/^Ir/,$p' | awk 'NR <= 25' |
     sed 's|/work/[^ ]*/main/||g' | cut -c1-160
   echo
   echo "inclusive:"
-  callgrind_annotate --inclusive=yes "$work/profile.cg" 2> /dev/null | sed -n '/^Ir/,$p' | head -30 |
+  callgrind_annotate --inclusive=yes "$work/profile.cg" 2> /dev/null | sed -n '/^Ir/,$p' | awk 'NR <= 30' |
     sed 's|/work/[^ ]*/main/||g' | cut -c1-160
   echo '```'
 } >> "$out"
