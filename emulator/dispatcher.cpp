@@ -224,11 +224,7 @@ bool lookupRecordChecked(ThreadState& ts, const Site& site, ProgramEntry::Kind k
         return true;
     }
     auto remember = [&] {
-        cached.table = table;
-        cached.index = index;
-        cached.kind = uint8_t(kind);
-        cached.geometry = geometry;
-        cached.view = out;
+        cached = {table, index, uint8_t(kind), geometry, out};
         return true;
     };
 
