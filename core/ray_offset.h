@@ -9,6 +9,7 @@
 // choice (TMin 0 from the hit point), which docs/numerical-stability.md measures.
 #pragma once
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -31,11 +32,17 @@ inline vec3 offsetRayOrigin(vec3 p, vec3 n) {
             out[i] = p[i];
             continue;
         }
-        // Stepping the integer representation moves |p| up or down by whole ulps; towards +n either way.
-        const auto ulps = int32_t(kOffsetIntScale * n[i]);
-        const int32_t bits = std::bit_cast<int32_t>(p[i]);
-        const float stepped = std::bit_cast<float>(bits + (p[i] < 0.0f ? -ulps : ulps));
-        out[i] = std::fabs(p[i]) < kOffsetOriginBand ? p[i] + kOffsetFloatScale * n[i] : stepped;
+        if (std::fabs(p[i]) < kOffsetOriginBand) {
+            out[i] = p[i] + kOffsetFloatScale * n[i];
+            continue;
+        }
+        // Stepping the integer representation moves |p| up or down by whole ulps; towards +n either way. Unsigned
+        // arithmetic wraps as the HLSL's int does, where C++'s signed overflow would be undefined; the clamp keeps
+        // the conversion of a huge normal component in range.
+        const float scaled = std::clamp(kOffsetIntScale * n[i], -2147483520.0f, 2147483520.0f);
+        const auto ulps = uint32_t(int32_t(scaled));
+        const auto bits = std::bit_cast<uint32_t>(p[i]);
+        out[i] = std::bit_cast<float>(p[i] < 0.0f ? bits - ulps : bits + ulps);
     }
     return out;
 }
