@@ -10,6 +10,7 @@
 
 #include "core/image.h"
 #include "harness.h"
+#include "tests/test_output.h"
 
 namespace refray::test {
 
@@ -23,9 +24,7 @@ struct Vertex {  // StructuredBuffer<Vertex> vertices[] : register(t0, space1)
 };
 
 std::string writeTexture(const std::string& name, const Image& image) {
-    const fs::path dir = fs::path(REFRAY_TEST_OUTPUT_DIR) / "resource_binding";
-    fs::create_directories(dir);
-    const std::string path = (dir / name).string();
+    const std::string path = (refray::testing::testOutputDirectory("resource_binding") / name).string();
     writeImage(path, image);
     return path;
 }
@@ -358,7 +357,7 @@ TEST(ResourceBinding, BIND_5_StrideAndLayoutMismatches) {
 TEST(ResourceBinding, BIND_6_ATextureFileThatCanNoLongerBeRead) {
     BindingScene s;
     // A tiled file: making the texture reads its first tile only. Then the file loses its other tiles.
-    const std::string path = (fs::path(REFRAY_TEST_OUTPUT_DIR) / "resource_binding" / "vanishing.exr").string();
+    const std::string path = (refray::testing::testOutputDirectory("resource_binding") / "vanishing.exr").string();
     {
         OIIO::ImageSpec spec(64, 64, 4, OIIO::TypeDesc::FLOAT);
         spec.tile_width = spec.tile_height = 16;

@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "emulator/texture.h"
 #include "harness.h"
+#include "tests/test_output.h"
 
 namespace refray::test {
 
@@ -19,11 +20,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path outputDir() {
-    const fs::path dir = fs::path(REFRAY_TEST_OUTPUT_DIR) / "texture";
-    fs::create_directories(dir);
-    return dir;
-}
+fs::path outputDir() { return refray::testing::testOutputDirectory("texture"); }
 
 // Writes `texels` (width * height * channels floats, rows top to bottom) with OpenImageIO: .exr as 32-bit float,
 // anything else as 8-bit (value * 255, rounded). With tileSize, a tiled file.

@@ -2,7 +2,7 @@
 // files, BLAS geometry from a model, the generated model buffers, InstanceID defaulting to the object index,
 // unbounded texture ranges, static samplers, the dxr-path-tracer library's constants and its spp, and the errors of
 // broken files (file:line:column, "did you mean"). The scene files are small and written here, beside a two-object
-// OBJ file in a fresh directory.
+// OBJ file in a directory of each test's own.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,6 +16,7 @@
 #include "scenes/scene.h"
 #include "scenes/scene_loader.h"
 #include "tests/scenes/scene_test_support.h"
+#include "tests/test_output.h"
 
 namespace refray::scenes {
 namespace {
@@ -117,8 +118,7 @@ const char* kScene = R"({
 class SceneLoaderModels : public ::testing::Test {
 protected:
     void SetUp() override {
-        directory_ = fs::path(REFRAY_TEST_OUTPUT_DIR) / "scene_loader_models";
-        fs::create_directories(directory_);
+        directory_ = refray::testing::testOutputDirectory("scene_loader_models");  // every test writes tiny.obj
         write("tiny.obj", kObj);
         write("tiny.mtl", kMtl);
     }
