@@ -1150,43 +1150,24 @@ const uint8_t* ShaderContext::rootArgument(bool local, uint32_t parameter, size_
     requireLive(local ? "a local root argument read" : "a global root argument read");
     // Arguments that passed rootArgumentChecked's checks pass them again (LookupCache): the same argument bytes
     // (those of one record, or the dispatch's global ones), parameter, size and type.
-    const uint8_t* bytes = nullptr;
-    uint64_t available = 0;
-    if (local) {
-        if (inv_.record) {
-            bytes = inv_.record->arguments;
-            available = inv_.record->argumentBytesAvailable;
-        }
-    } else if (inv_.dispatch->global) {
-        bytes = inv_.dispatch->global->bytes().data();
-        available = inv_.dispatch->global->bytes().size();
-    }
+    const detail::ArgumentBytes arguments = detail::argumentBytes(inv_, *inv_.dispatch, local);
     const detail::LookupCache::RootArgument& cached =
-        inv_.thread->lookups.rootArguments[detail::LookupCache::rootArgumentSlot(bytes, parameter)];
-    if (bytes && cached.arguments == bytes && cached.available == available && cached.parameter == parameter &&
-        cached.size == size && cached.type == type.id)
+        inv_.thread->lookups.rootArguments[detail::LookupCache::rootArgumentSlot(arguments.bytes, parameter)];
+    if (arguments.bytes && cached.arguments == arguments.bytes && cached.available == arguments.available &&
+        cached.parameter == parameter && cached.size == size && cached.type == type.id)
         return cached.bytes;
-    return rootArgumentChecked(local, parameter, size, type);
+    return rootArgumentChecked(local, parameter, size, type, arguments);
 }
 
-const uint8_t* ShaderContext::rootArgumentChecked(bool local, uint32_t parameter, size_t size, TypeTag type) const {
+const uint8_t* ShaderContext::rootArgumentChecked(bool local, uint32_t parameter, size_t size, TypeTag type,
+                                                  const detail::ArgumentBytes& arguments) const {
     const RootSignature* signature = nullptr;
-    const uint8_t* bytes = nullptr;
-    const uint8_t* written = nullptr;
-    uint64_t available = 0;
     if (local) {
         if (inv_.record && inv_.record->entry) signature = inv_.record->entry->localRootSignature.get();
-        if (signature) {
-            bytes = inv_.record->arguments;
-            written = inv_.record->argumentsWritten;
-            available = inv_.record->argumentBytesAvailable;
-        }
     } else if (inv_.dispatch->global) {
         signature = inv_.dispatch->global->signature().get();
-        bytes = inv_.dispatch->global->bytes().data();
-        written = inv_.dispatch->global->setMask().data();
-        available = inv_.dispatch->global->bytes().size();
     }
+    const auto& [bytes, written, available] = arguments;
     const char* which = local ? "local" : "global";
     if (!signature)
         stageError(inv_, local ? "REC-11" : "PIPE-6",

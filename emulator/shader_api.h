@@ -22,6 +22,7 @@ namespace refray::dxr {
 namespace detail {
 constexpr uint8_t stageBit(ShaderStage s) { return uint8_t(1u << uint8_t(s)); }
 struct BoundResource;  // shader_resources.cpp
+struct ArgumentBytes;  // dispatch_state.h
 }  // namespace detail
 
 class ShaderContext;
@@ -250,7 +251,8 @@ private:
                   const RayDesc& ray, void* payload, TypeTag payloadType);
     void callShader(uint32_t index, void* parameters, TypeTag type);
     const uint8_t* rootArgument(bool local, uint32_t parameter, size_t size, TypeTag type) const;
-    const uint8_t* rootArgumentChecked(bool local, uint32_t parameter, size_t size, TypeTag type) const;
+    const uint8_t* rootArgumentChecked(bool local, uint32_t parameter, size_t size, TypeTag type,
+                                       const detail::ArgumentBytes& arguments) const;
     const uint8_t* readMemory(GpuVirtualAddress address, uint64_t size) const;
     void readBufferView(GpuDescriptorHandle tableHandle, uint32_t offset, uint64_t byteOffset, uint64_t size,
                         void* out) const;

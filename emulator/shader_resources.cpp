@@ -290,19 +290,7 @@ void ShaderContext::readConstantBuffer(uint32_t shaderRegister, uint32_t space, 
                 bindingError("BIND-5", r,
                              "the shader reads " + std::to_string(size) + " bytes but " + r.source() + " holds " +
                                  std::to_string(4 * p.num32BitValues) + " bytes of constants");
-            // The argument bytes: the record's after its identifier, or what SetComputeRoot32BitConstants set.
-            const uint8_t* bytes = nullptr;
-            const uint8_t* written = nullptr;
-            uint64_t available = 0;
-            if (r.local) {
-                bytes = inv_.record->arguments;
-                written = inv_.record->argumentsWritten;
-                available = inv_.record->argumentBytesAvailable;
-            } else {
-                bytes = inv_.dispatch->global->bytes().data();
-                written = inv_.dispatch->global->setMask().data();
-                available = inv_.dispatch->global->bytes().size();
-            }
+            const auto [bytes, written, available] = detail::argumentBytes(inv_, *inv_.dispatch, r.local);
             const std::string which = r.local ? "local" : "global";
             const uint32_t offset = r.signature->argumentOffset(r.binding->index) - kShaderIdentifierSizeInBytes;
             if (offset + size > available)

@@ -25,6 +25,22 @@ struct DispatchState {
     std::atomic<uint64_t> firstErrorIndex{~0ull};
 };
 
+// The root argument bytes a shader reads: its record's after the identifier (local), or what the dispatch's
+// SetComputeRoot* calls set (global). All null when there are none (no record, no global arguments).
+struct ArgumentBytes {
+    const uint8_t* bytes = nullptr;
+    const uint8_t* written = nullptr;  // 1 where the host wrote the byte (REC-7)
+    uint64_t available = 0;
+};
+inline ArgumentBytes argumentBytes(const Invocation& inv, const DispatchState& ds, bool local) {
+    if (local)
+        return inv.record ? ArgumentBytes{inv.record->arguments, inv.record->argumentsWritten,
+                                          inv.record->argumentBytesAvailable}
+                          : ArgumentBytes{};
+    return ds.global ? ArgumentBytes{ds.global->bytes().data(), ds.global->setMask().data(), ds.global->bytes().size()}
+                     : ArgumentBytes{};
+}
+
 // Lookups a dispatch repeats with the same answer, remembered per worker thread. While a dispatch runs its shader
 // tables are locked (REC-12), its global root arguments are fixed and no GPU buffer comes or goes, so a lookup that
 // succeeded once succeeds again with the same result. Only successes are kept: every failure still goes through
