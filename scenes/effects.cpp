@@ -144,8 +144,12 @@ std::string notRun(const Activity& a, const SceneDesc& scene, const char* what) 
     return text;
 }
 
-// Geometry of one type in the BLASes of the instances some ray type can reach (INST-4: mask & inclusion mask).
-Effect geometryEffect(const SceneDesc& scene, dxr::GeometryType type, const char* name, const std::string& kind) {
+// Geometry of one type in the BLASes of the instances some ray type can reach (INST-4: mask & inclusion mask): the
+// "triangles" or the "procedural primitives" effect.
+Effect geometryEffect(const SceneDesc& scene, dxr::GeometryType type) {
+    const bool triangles = type == dxr::GeometryType::Triangles;
+    const char* name = triangles ? "triangles" : "procedural primitives";
+    const std::string kind = triangles ? "triangle" : "AABB";
     uint32_t rayMask = 0;
     for (const RayTypeDesc& t : scene.rayTypes) rayMask |= t.instanceInclusionMask;
     std::vector<std::string> blases, instances;
@@ -347,8 +351,8 @@ EffectSet computeEffects(const SceneDesc& scene, const RenderSettings& settings)
     depthText += ')';
 
     // Geometry and the pipeline's shader stages.
-    e.triangles = geometryEffect(scene, dxr::GeometryType::Triangles, "triangles", "triangle");
-    e.procedural = geometryEffect(scene, dxr::GeometryType::ProceduralPrimitiveAABBs, "procedural primitives", "AABB");
+    e.triangles = geometryEffect(scene, dxr::GeometryType::Triangles);
+    e.procedural = geometryEffect(scene, dxr::GeometryType::ProceduralPrimitiveAABBs);
     e.anyHit = anyHitEffect(scene);
     e.triangleCulling = cullingEffect(scene, facts, e.triangles);
     e.geometrySkip = geometrySkipEffect(scene, facts, e.triangles, e.procedural, e.pipelineFlags);
@@ -530,8 +534,8 @@ EffectSet computeEffects(const SceneDesc& scene, const RenderSettings& settings)
 uint32_t geometrySkipPipelineFlags(const SceneDesc& scene) {
     uint32_t flags = dxr::PIPELINE_FLAG_NONE;
     geometrySkipEffect(scene, findShaderLibrary(scene.shaderLibrary).facts,
-                       geometryEffect(scene, dxr::GeometryType::Triangles, "triangles", "triangle"),
-                       geometryEffect(scene, dxr::GeometryType::ProceduralPrimitiveAABBs, "procedural primitives", "AABB"),
+                       geometryEffect(scene, dxr::GeometryType::Triangles),
+                       geometryEffect(scene, dxr::GeometryType::ProceduralPrimitiveAABBs),
                        flags);
     return flags;
 }
