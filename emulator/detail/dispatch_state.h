@@ -2,6 +2,7 @@
 // emulator: dispatcher.cpp runs the dispatch, shader_resources.cpp serves the resource intrinsics from it.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstdint>
@@ -50,18 +51,13 @@ struct LookupCache {
     std::array<const GpuBuffer*, 4> buffers{};
     // The buffer holding [va, va + n): from the cache, else from `memory` (then cached); nullptr if none holds it.
     const GpuBuffer* findBuffer(const GpuMemory& memory, GpuVirtualAddress va, uint64_t n) {
-        for (size_t i = 0; i < buffers.size(); ++i)
-            if (buffers[i] && buffers[i]->contains(va, n)) {
-                const GpuBuffer* hit = buffers[i];
-                for (; i > 0; --i) buffers[i] = buffers[i - 1];
-                return buffers[0] = hit;
-            }
-        const GpuBuffer* found = memory.find(va, n);
-        if (found) {
-            for (size_t i = buffers.size() - 1; i > 0; --i) buffers[i] = buffers[i - 1];
-            buffers[0] = found;
-        }
-        return found;
+        size_t i = 0;
+        while (i < buffers.size() && !(buffers[i] && buffers[i]->contains(va, n))) ++i;
+        const GpuBuffer* found = i < buffers.size() ? buffers[i] : memory.find(va, n);
+        if (!found) return nullptr;
+        // Move it to the front; a buffer new to the cache pushes out the last.
+        for (i = std::min(i, buffers.size() - 1); i > 0; --i) buffers[i] = buffers[i - 1];
+        return buffers[0] = found;
     }
 
     // Root arguments that passed ShaderContext::rootArgument's checks: the argument bytes they were read from (a
