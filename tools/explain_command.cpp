@@ -8,7 +8,7 @@
 #include "core/error.h"
 #include "core/json_writer.h"
 #include "core/strings.h"
-#include "scenes/explain.h"
+#include "inspect/explain.h"
 #include "tools/cli_common.h"
 
 namespace refray::tools {

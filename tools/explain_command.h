@@ -1,4 +1,4 @@
-// `refray explain SCENE --pixel X,Y`: the ray tree of one pixel (scenes/explain.h), as text or JSON.
+// `refray explain SCENE --pixel X,Y`: the ray tree of one pixel (inspect/explain.h), as text or JSON.
 // docs/tutorial-indexing.md walks through its output.
 #pragma once
 

@@ -8,8 +8,8 @@
 #include "core/progress.h"
 #include "core/strings.h"
 #include "scenes/knobs.h"
-#include "scenes/sweep.h"
-#include "scenes/sweep_report.h"
+#include "study/sweep.h"
+#include "study/sweep_report.h"
 #include "tools/cli_common.h"
 
 namespace refray::tools {

@@ -1,4 +1,4 @@
-// `refray sweep SCENE --knob NAME=v1,v2,... [--knob ...]`: what accuracy costs in time (scenes/sweep.h). Renders
+// `refray sweep SCENE --knob NAME=v1,v2,... [--knob ...]`: what accuracy costs in time (study/sweep.h). Renders
 // every knob value, times it, compares it with a high-accuracy reference and writes a CSV, a markdown report and
 // plots into the output directory. --emit-jobs writes one command line per setting for a job runner (GNU parallel,
 // a Slurm array) instead of rendering; --collect DIR merges what those jobs wrote into the same report.

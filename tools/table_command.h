@@ -1,6 +1,6 @@
 // `refray table SCENE`: the shader tables of a scene as the GPU sees them (records, identifiers, decoded local
 // root arguments), the instances and geometries that feed the indexing rule, and a static check of
-// I = R + M*G + C for every instance x geometry x ray type (scenes/table_view.h), as text or JSON.
+// I = R + M*G + C for every instance x geometry x ray type (inspect/table_view.h), as text or JSON.
 //
 // Wiring into the main program (tools/refray.cpp):
 //     refray::tools::TableCommandOptions tableOptions;
@@ -13,7 +13,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "scenes/table_view.h"
+#include "inspect/table_view.h"
 
 namespace refray::tools {
 

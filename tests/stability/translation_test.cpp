@@ -1,6 +1,6 @@
 // Stability: an object's image under translation of the whole scene (issue 6).
 //
-// The scene is tests/scenes/table_view_test.cpp's kExplicit (the D3D12 sample's shader library, its ground plane
+// The scene is tests/inspect/table_view_test.cpp's kExplicit (the D3D12 sample's shader library, its ground plane
 // and one AABB of analytic spheres) with every world position moved by an offset: both instance translations, the
 // camera's eye and target, and the light. The spheres' `primitiveTransforms` centre is object space (the AABB's
 // centre in the BLAS) and the ground's vertices are object space, so neither moves. The offset is

@@ -1,4 +1,4 @@
-#include "scenes/sweep_report.h"
+#include "study/sweep_report.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-// Tests scenes/table_view.cpp: the shader tables of both reference scenes read back from GPU memory, checked
+// Tests inspect/table_view.cpp: the shader tables of both reference scenes read back from GPU memory, checked
 // against the fact sheets (reference-scene-proceduray.md §1.2-1.8, reference-scene-d3d12-procedural.md §1.2-1.8),
 // and the reachability findings of small scenes whose explicit layout is broken on purpose.
 #include <gtest/gtest.h>
@@ -7,7 +7,7 @@
 
 #include "scenes/scene.h"
 #include "scenes/scene_loader.h"
-#include "scenes/table_view.h"
+#include "inspect/table_view.h"
 #include "tests/scenes/scene_test_support.h"
 
 namespace refray::scenes {

@@ -8,7 +8,7 @@
 
 #include "core/compare.h"
 #include "core/hash.h"
-#include "scenes/golden.h"
+#include "verify/golden.h"
 #include "scenes/scene_loader.h"
 
 namespace refray::scenes {

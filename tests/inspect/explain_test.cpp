@@ -1,11 +1,11 @@
-// Tests scenes/explain.cpp: one pixel's ray tree, recorded from the trace events of a one-pixel dispatch.
+// Tests inspect/explain.cpp: one pixel's ray tree, recorded from the trace events of a one-pixel dispatch.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
 #include "core/json.h"
-#include "scenes/explain.h"
-#include "scenes/index_map.h"
+#include "inspect/explain.h"
+#include "inspect/index_map.h"
 #include "scenes/scene.h"
 #include "tests/scenes/scene_test_support.h"
 

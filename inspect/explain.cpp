@@ -1,4 +1,4 @@
-#include "scenes/explain.h"
+#include "inspect/explain.h"
 
 #include <cinttypes>
 #include <cstdio>

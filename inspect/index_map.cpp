@@ -1,4 +1,4 @@
-#include "scenes/index_map.h"
+#include "inspect/index_map.h"
 
 #include <algorithm>
 #include <cmath>

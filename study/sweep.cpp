@@ -1,4 +1,4 @@
-#include "scenes/sweep.h"
+#include "study/sweep.h"
 
 #include <unistd.h>
 
@@ -18,7 +18,7 @@
 #include "core/text_file.h"
 #include "scenes/knobs.h"
 #include "scenes/scene.h"
-#include "scenes/sweep_report.h"
+#include "study/sweep_report.h"
 
 namespace refray::scenes {
 

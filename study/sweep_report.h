@@ -1,4 +1,4 @@
-// The report of a sweep (scenes/sweep.h): Pareto fronts, the golden settings, the CSV, the markdown table and the
+// The report of a sweep (study/sweep.h): Pareto fronts, the golden settings, the CSV, the markdown table and the
 // plots of error against time.
 #pragma once
 
@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "scenes/sweep.h"
+#include "study/sweep.h"
 
 namespace refray::scenes {
 

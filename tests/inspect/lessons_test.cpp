@@ -8,7 +8,7 @@
 #include "emulator/validation.h"
 #include "scenes/scene.h"
 #include "scenes/scene_loader.h"
-#include "scenes/table_view.h"
+#include "inspect/table_view.h"
 #include "tests/scenes/scene_test_support.h"
 
 namespace refray::scenes {

@@ -1,4 +1,4 @@
-#include "scenes/order_check.h"
+#include "verify/order_check.h"
 
 #include <cstring>
 #include <filesystem>

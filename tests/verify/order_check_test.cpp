@@ -1,10 +1,10 @@
-// Tests scenes/order_check.cpp: the order-dependence mask (GEN-3) on the Proceduray scene, whose intersection
+// Tests verify/order_check.cpp: the order-dependence mask (GEN-3) on the Proceduray scene, whose intersection
 // shaders report t in local units (H1), so the closest hit can depend on the enumeration order (§1.10, H2).
 #include <gtest/gtest.h>
 
 #include <cstring>
 
-#include "scenes/order_check.h"
+#include "verify/order_check.h"
 #include "scenes/scene_loader.h"
 
 namespace refray::scenes {

@@ -1,4 +1,4 @@
-#include "scenes/table_view.h"
+#include "inspect/table_view.h"
 
 #include <algorithm>
 #include <charconv>

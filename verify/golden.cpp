@@ -1,4 +1,4 @@
-#include "scenes/golden.h"
+#include "verify/golden.h"
 
 #include <algorithm>
 #include <chrono>

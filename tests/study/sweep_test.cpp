@@ -1,4 +1,4 @@
-// The accuracy knobs by name (scenes/knobs.h) and `refray sweep`'s plan, jobs and report (scenes/sweep.h).
+// The accuracy knobs by name (scenes/knobs.h) and `refray sweep`'s plan, jobs and report (study/sweep.h).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -8,8 +8,8 @@
 #include "core/error.h"
 #include "scenes/knobs.h"
 #include "scenes/scene.h"
-#include "scenes/sweep.h"
-#include "scenes/sweep_report.h"
+#include "study/sweep.h"
+#include "study/sweep_report.h"
 #include "tests/scenes/scene_test_support.h"
 #include "tests/error_of.h"
 

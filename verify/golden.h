@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/statistical_compare.h"
-#include "scenes/order_check.h"
+#include "verify/order_check.h"
 #include "scenes/scene.h"
 
 namespace refray::scenes {

@@ -1,9 +1,9 @@
-// Tests scenes/index_map.cpp: the record / instance / hit group / depth of each pixel's primary ray.
+// Tests inspect/index_map.cpp: the record / instance / hit group / depth of each pixel's primary ray.
 #include <gtest/gtest.h>
 
 #include <set>
 
-#include "scenes/index_map.h"
+#include "inspect/index_map.h"
 #include "scenes/scene.h"
 #include "tests/scenes/scene_test_support.h"
 

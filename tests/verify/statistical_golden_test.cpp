@@ -1,4 +1,4 @@
-// The statistical goldens of tests/golden/goldens.json (scenes/golden.h): each Monte Carlo golden re-rendered with
+// The statistical goldens of tests/golden/goldens.json (verify/golden.h): each Monte Carlo golden re-rendered with
 // other seeds passes `compare --statistical` (core/statistical_compare.h) against its statistics image, and for the
 // Cornell box a render whose red wall reflects 10 % less fails it, so the golden can see such a change. How the
 // size, spp and batches were chosen: docs/compare.md, "The Cornell box golden".
@@ -11,7 +11,7 @@
 #include "core/hash.h"
 #include "core/image.h"
 #include "core/statistical_compare.h"
-#include "scenes/golden.h"
+#include "verify/golden.h"
 #include "scenes/scene_loader.h"
 #include "tests/scenes/scene_test_support.h"
 
