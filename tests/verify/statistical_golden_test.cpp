@@ -14,6 +14,7 @@
 #include "verify/golden.h"
 #include "scenes/scene_loader.h"
 #include "tests/scenes/scene_test_support.h"
+#include "tests/test_output.h"
 
 namespace refray::scenes {
 namespace {
@@ -98,7 +99,7 @@ GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(StatisticalGolden);
 TEST(StatisticalGoldenManifest, RoundTrips) {
     GoldenSet set = readGoldenManifest(kGoldenDirectory / "goldens.json");
     ASSERT_FALSE(set.statistical.empty());
-    const fs::path copy = fs::path(REFRAY_TEST_OUTPUT_DIR) / "goldens-round-trip.json";
+    const fs::path copy = refray::testing::testOutputDirectory("manifest") / "goldens-round-trip.json";
     writeGoldenManifest(copy, set);
     const GoldenSet again = readGoldenManifest(copy);
     ASSERT_EQ(again.entries.size(), set.entries.size());
