@@ -1,9 +1,11 @@
 // SHA-256 (FIPS 180-4), for provenance: a golden image records the hash of the scene file it came from.
+// OpenSSL's libcrypto computes it; its headers stay in core/hash.cpp.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <string_view>
 
@@ -12,17 +14,15 @@ namespace refray {
 class Sha256 {
 public:
     Sha256();
+    ~Sha256();
     Sha256& update(const void* data, size_t size);
     Sha256& update(std::string_view text) { return update(text.data(), text.size()); }
     std::array<uint8_t, 32> digest();  // finishes; call once
     std::string hexDigest();           // lower-case hex of digest()
 
 private:
-    void block(const uint8_t* p);
-    std::array<uint32_t, 8> h_;
-    std::array<uint8_t, 64> buffer_{};
-    size_t buffered_ = 0;
-    uint64_t length_ = 0;
+    struct Context;  // OpenSSL's digest context
+    std::unique_ptr<Context> context_;
 };
 
 std::string sha256Hex(std::string_view bytes);

@@ -70,14 +70,15 @@ StatisticsImage readStatisticsImage(const std::string& path);
 
 // ---- The t-test ----------------------------------------------------------------------
 
-// The regularized incomplete beta function I_x(a, b), a, b > 0, x in [0, 1], by its
-// continued fraction (modified Lentz). Throws refray::Error outside that domain.
+// The regularized incomplete beta function I_x(a, b), a, b > 0, x in [0, 1] (Boost.Math's
+// ibeta). Throws refray::Error outside that domain.
 double regularizedIncompleteBeta(double a, double b, double x);
 
-// Student's t distribution with `df` > 0 degrees of freedom: the CDF P(T <= t), and the
-// two-sided p-value P(|T| >= |t|) = I_{df/(df+t²)}(df/2, 1/2). The relative error is
-// about 1e-12 up to 10^4 degrees of freedom and grows as 1e-17·df; beyond 1e10 (infinity
-// included) both use the normal distribution, within 1e-7 there. NaN t gives NaN.
+// Student's t distribution with `df` > 0 degrees of freedom (Boost.Math's students_t): the
+// CDF P(T <= t), and the two-sided p-value P(|T| >= |t|) = I_{df/(df+t²)}(df/2, 1/2), taken
+// from the upper tail so that small p-values keep their relative precision (within 1e-14
+// wherever the p-value is a normal double, at any df). Beyond 1/epsilon = 4.5e15 degrees of
+// freedom (infinity included) both are the normal distribution's. NaN t gives NaN.
 double studentTCdf(double t, double df);
 double studentTTwoSidedP(double t, double df);
 

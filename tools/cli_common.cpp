@@ -1,7 +1,12 @@
 #include "tools/cli_common.h"
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
+#include <charconv>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -9,6 +14,7 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/strings.h"
 
 namespace refray::tools {
 
@@ -45,6 +51,113 @@ void parsePixel(const std::string& text, uint32_t& x, uint32_t& y, const char* o
     REFRAY_CHECK(parseNumberPair(text, ',', a, b), option << " expects X,Y (e.g. 640,360), got '" << text << "'");
     x = uint32_t(a);
     y = uint32_t(b);
+}
+
+namespace {
+
+std::string expects(const std::string& accepts, const std::string& text) {
+    return "expects " + accepts + ", got '" + text + "'";
+}
+
+// "a", "a or b", "a, b or c".
+std::string alternatives(const std::vector<std::string>& names) {
+    if (names.size() < 2) return joined(names);
+    return joined(std::vector<std::string>(names.begin(), names.end() - 1)) + " or " + names.back();
+}
+
+// The option names of `command` as a user types them ("--spp", "-o").
+std::vector<std::string> optionNames(const CLI::App& command) {
+    std::vector<std::string> names;
+    for (const CLI::Option* option : command.get_options()) {
+        for (const std::string& name : option->get_lnames()) names.push_back("--" + name);
+        for (const std::string& name : option->get_snames()) names.push_back("-" + name);
+    }
+    return names;
+}
+
+// What a command was given and does not take: "unknown option --sp (did you mean '--spp'?)", "unexpected argument
+// 'b.json'".
+std::string describeExtras(const CLI::App& command) {
+    std::vector<std::string> parts;
+    for (const std::string& arg : command.remaining()) {
+        const bool option = arg.size() > 1 && arg[0] == '-' && !std::isdigit((unsigned char)arg[1]);
+        const std::string name = arg.substr(0, arg.find('='));
+        parts.push_back(option ? "unknown option " + name + didYouMean(name, optionNames(command))
+                               : "unexpected argument '" + arg + "'");
+    }
+    return joined(parts, "; ");
+}
+
+}  // namespace
+
+CLI::Validator wholeNumber(const std::string& accepts, uint64_t min, uint64_t max) {
+    return CLI::Validator(
+        [=](std::string& text) -> std::string {
+            uint64_t value = 0;
+            const char* end = text.data() + text.size();
+            const auto [stop, error] = std::from_chars(text.data(), end, value);
+            if (text.empty() || error != std::errc() || stop != end || value < min || value > max)
+                return expects(accepts, text);
+            return {};
+        },
+        "");
+}
+
+CLI::Validator number(const std::string& accepts, const std::function<bool(double)>& inRange) {
+    return CLI::Validator(
+        [=](std::string& text) -> std::string {
+            char* end = nullptr;
+            const double value = std::strtod(text.c_str(), &end);
+            if (text.empty() || *end != '\0' || std::isnan(value) || !inRange(value)) return expects(accepts, text);
+            return {};
+        },
+        "");
+}
+
+CLI::Validator oneOf(const std::vector<std::string>& names) {
+    return CLI::Validator(
+        [=](std::string& text) -> std::string {
+            if (std::find(names.begin(), names.end(), text) != names.end()) return {};
+            return expects(alternatives(names), text) + didYouMean(text, names);
+        },
+        "");
+}
+
+CLI::Validator threadCount() { return wholeNumber("a number of worker threads (0: all)"); }
+
+CLI::Validator seconds() {
+    return number("a time in seconds", [](double t) { return std::isfinite(t); });
+}
+
+int parseErrorStatus(const CLI::App& app, const CLI::ParseError& error) {
+    if (dynamic_cast<const CLI::Success*>(&error)) return app.exit(error);  // --help, --version
+    // The subcommands given, outermost first; the error is about the last one's options, except for arguments that
+    // one before it does not take.
+    std::vector<const CLI::App*> chain{&app};
+    while (!chain.back()->get_subcommands().empty()) chain.push_back(chain.back()->get_subcommands().back());
+    const CLI::App* command = chain.back();
+    std::string message = error.what();
+    if (dynamic_cast<const CLI::ExtrasError*>(&error)) {
+        const auto with =
+            std::find_if(chain.begin(), chain.end(), [](const CLI::App* a) { return a->remaining_size() > 0; });
+        if (with != chain.end()) {
+            command = *with;
+            message = describeExtras(*command);
+        }
+    } else if (dynamic_cast<const CLI::RequiredError*>(&error) && command->get_require_subcommand_min() > 0 &&
+               command->get_subcommands().empty()) {
+        std::vector<std::string> names;
+        for (const CLI::App* sub : command->get_subcommands([](const CLI::App*) { return true; }))
+            names.push_back(sub->get_name());
+        message = "expects a subcommand (" + alternatives(names) + ")";
+        const std::vector<std::string> given = command->remaining();
+        if (!given.empty()) message += ", got '" + given.front() + "'" + didYouMean(given.front(), names);
+    }
+    chain.erase(std::find(chain.begin(), chain.end(), command) + 1, chain.end());
+    std::string name = "refray";
+    for (auto a = chain.begin() + 1; a != chain.end(); ++a) name += " " + (*a)->get_name();
+    std::fprintf(stderr, "%s: %s (see '%s --help')\n", name.c_str(), message.c_str(), name.c_str());
+    return 2;
 }
 
 Progress::Sink terminalProgress() {

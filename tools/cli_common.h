@@ -1,8 +1,13 @@
-// Small pieces the refray subcommands share: option parsing and the terminal progress bar.
+// Small pieces the refray subcommands share: option parsing, parse errors and the terminal progress bar.
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <limits>
 #include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
 
 #include "core/image.h"
 #include "core/progress.h"
@@ -18,6 +23,25 @@ struct Size {
 Size parseSize(const std::string& text, const char* option = "--size");
 // "X,Y": two non-negative integers; throws refray::Error naming the option otherwise.
 void parsePixel(const std::string& text, uint32_t& x, uint32_t& y, const char* option = "--pixel");
+
+// CLI11 validators whose failure says what the option accepts: "--spp: expects a positive integer ..., got '-4'"
+// (CLI11's own conversion errors only say "Could not convert").
+// A whole number (digits only: no sign, fraction or exponent) from `min` to `max`.
+CLI::Validator wholeNumber(const std::string& accepts, uint64_t min = 0,
+                           uint64_t max = std::numeric_limits<uint32_t>::max());
+// A number as strtod reads it ("inf" included, NaN never) for which `inRange` holds.
+CLI::Validator number(const std::string& accepts, const std::function<bool(double)>& inRange);
+// One of `names`, with a "did you mean" for a near miss.
+CLI::Validator oneOf(const std::vector<std::string>& names);
+// What --threads and --time accept in every command that has them.
+CLI::Validator threadCount();
+CLI::Validator seconds();
+
+// The exit status of a CLI11 parse error, after printing it: --help and --version print to stdout and give 0; every
+// other error (an unknown option, a value an option does not accept, a missing or an extra argument) prints
+// "refray SUBCOMMAND: what is wrong (see 'refray SUBCOMMAND --help')" to stderr and gives 2, bad input's status.
+int parseErrorStatus(const CLI::App& app, const CLI::ParseError& error);
+
 // A progress bar on stderr when it is a terminal; an empty sink otherwise.
 Progress::Sink terminalProgress();
 // Writes `image`, creating the parent directory.

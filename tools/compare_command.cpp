@@ -44,28 +44,8 @@ See docs/compare.md.)";
 
 // A number >= 0 (or > 0 when `positive`), "inf" included: CLI11's range validators stop at DBL_MAX.
 CLI::Validator numberAtLeastZero(bool positive) {
-    return CLI::Validator(
-        [positive](std::string& text) -> std::string {
-            char* end = nullptr;
-            const double value = std::strtod(text.c_str(), &end);
-            if (text.empty() || *end != '\0' || std::isnan(value) || value < 0.0 || (positive && value == 0.0))
-                return std::string("expects a number ") + (positive ? "> 0" : ">= 0") + ", got '" + text + "'";
-            return {};
-        },
-        "");
-}
-
-// A number strictly between 0 and 1.
-CLI::Validator openUnitInterval() {
-    return CLI::Validator(
-        [](std::string& text) -> std::string {
-            char* end = nullptr;
-            const double value = std::strtod(text.c_str(), &end);
-            if (text.empty() || *end != '\0' || !(value > 0.0 && value < 1.0))
-                return "expects a number between 0 and 1 (exclusive), got '" + text + "'";
-            return {};
-        },
-        "");
+    if (positive) return number("a number > 0", [](double v) { return v > 0.0; });
+    return number("a number >= 0", [](double v) { return v >= 0.0; });
 }
 
 bool readStatisticsInto(const std::string& path, StatisticsImage& stats) {
@@ -166,14 +146,14 @@ CLI::App* addCompareCommand(CLI::App& app, CompareCommandOptions& o) {
     sub->add_flag("--golden", o.golden,
                   "Tolerances for a GPU render against a refray golden PNG: --fail 0.005 --failpercent 0.1 --warn 0.005");
     sub->add_option("--channels", o.channels, "Channels compared: rgb (default; DXR samples' alpha means nothing) or rgba")
-        ->check(CLI::IsMember({"rgb", "rgba"}));
+        ->check(oneOf({"rgb", "rgba"}));
     sub->add_option("--mask", o.maskPath, "Mask image: pixels with non-zero RGB are order-dependent, reported apart "
                                           "and left out of the verdict");
     sub->add_option("-o,--diff", o.diffPath, "Write a diff heat map (PNG): FLIP error through the magma ramp, "
                                              "black = no visible difference");
     sub->add_option("--diff-mode", o.diffMode, "Diff heat map of 'flip' (default) or 'abs': largest channel "
                                                "|difference| x --diff-scale through magma")
-        ->check(CLI::IsMember({"flip", "abs"}));
+        ->check(oneOf({"flip", "abs"}));
     sub->add_option("--diff-scale", o.diffScale, "Scale of --diff-mode abs")->check(numberAtLeastZero(true))->capture_default_str();
     sub->add_option("--html", o.htmlPath, "Write a self-contained HTML report");
     CLI::Option* ppd = sub->add_option("--ppd", o.pixelsPerDegree, "FLIP's pixels per degree of visual angle")
@@ -184,11 +164,13 @@ CLI::App* addCompareCommand(CLI::App& app, CompareCommandOptions& o) {
                   "'refray render --batches K'): a Welch t-test per pixel and channel");
     CLI::Option* alpha = sub->add_option("--alpha", o.alpha,
                                          "--statistical: the probability of a false alarm for the whole image")
-                             ->check(openUnitInterval())->capture_default_str();
+                             ->check(number("a number between 0 and 1 (exclusive)",
+                                            [](double a) { return a > 0.0 && a < 1.0; }))
+                             ->capture_default_str();
     CLI::Option* correction =
         sub->add_option("--correction", o.correction,
                         "--statistical: the multiple-comparison correction, sidak (default) or bonferroni")
-            ->check(CLI::IsMember({"sidak", "bonferroni"}));
+            ->check(oneOf({"sidak", "bonferroni"}));
     CLI::Option* map = sub->add_option("--map", o.mapPath,
                                        "--statistical: write the failure map (PNG): red where a pixel fails, magenta "
                                        "for NaN or infinity, grey rising with -log10 p elsewhere");

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -20,10 +21,11 @@ CLI::App* addExplainCommand(CLI::App& app, ExplainCommandOptions& o) {
     c->add_option("--pixel", o.pixel, "The pixel X,Y (0,0 = top left), as in the rendered image");
     c->add_option("--camera", o.camera, "Camera name (default: the scene's defaultCamera)");
     c->add_option("--size", o.size, "Image size WIDTHxHEIGHT (default: the scene's imageSize)");
-    c->add_option("--time", o.time, "Animation time in seconds (default: the scene's default time)");
+    c->add_option("--time", o.time, "Animation time in seconds (default: the scene's default time)")->check(seconds());
     c->add_option("--precision", o.precision, "Shader math precision: float or double")->capture_default_str();
     c->add_option("--order", o.order, "Traversal order: ordered (default) or adversarial (GEN-3)");
-    c->add_option("--seed", o.seed, "Seed of the adversarial order");
+    c->add_option("--seed", o.seed, "Seed of the adversarial order")
+        ->check(wholeNumber("a seed from 0 to 18446744073709551615", 0, std::numeric_limits<uint64_t>::max()));
     c->add_flag("--json", o.json, "Write JSON (format refray-explain/1) instead of text");
     c->add_option("-o,--output", o.output, "Write to this file instead of stdout");
     c->add_option("--html", o.html,

@@ -368,26 +368,32 @@ int main(int argc, char** argv) {
         ->capture_default_str();
     render->add_option("--size", ro.size, "Image size WIDTHxHEIGHT (default: the scene's imageSize)");
     render->add_option("--camera", ro.camera, "Camera name (default: the scene's defaultCamera)");
-    render->add_option("--time", ro.time, "Animation time in seconds (default: the scene's default time)");
+    render->add_option("--time", ro.time, "Animation time in seconds (default: the scene's default time)")
+        ->check(tools::seconds());
     render->add_option("--precision", ro.precision, "Shader math precision: float (the GPU's) or double")
         ->capture_default_str();
     render->add_option("--spp", ro.spp, "Samples per pixel: a square number (k x k pixel centres of a k-times larger "
                                         "dispatch, averaged); for dxr-path-tracer scenes any N (random paths per "
                                         "pixel, averaged by the shader)")
+        ->check(tools::wholeNumber("a positive integer (a square number k*k; for the path tracer any N)", 1))
         ->capture_default_str();
     render->add_option("--knob", ro.knobs,
                        "An accuracy knob, NAME=VALUE (repeatable): steps, threshold, mandelbulb-iterations, "
                        "julia-iterations, normal-epsilon, metaball-steps, recursion-depth, spp, precision "
                        "(see 'refray sweep --help')");
-    render->add_option("--threads", ro.threads, "Worker threads (0: all)")->capture_default_str();
+    render->add_option("--threads", ro.threads, "Worker threads (0: all)")
+        ->check(tools::threadCount())
+        ->capture_default_str();
     render->add_option("--order", ro.order, "Traversal order: ordered (default) or adversarial (GEN-3)");
     render->add_option("--seed", ro.seed,
                        "Random seed: RenderSettings::seed, for shaders that sample at random (the first batch's with "
                        "--batches), and the seed of the adversarial order")
+        ->check(tools::wholeNumber("a seed from 0 to 4294967295"))
         ->capture_default_str();
     render->add_option("--batches", ro.batches,
                        "Render K >= 2 times with seeds S, S+1, ..., S+K-1 and write a statistics image (-o FILE.exr: "
-                       "the mean and the variance of the mean) for 'refray compare --statistical'");
+                       "the mean and the variance of the mean) for 'refray compare --statistical'")
+        ->check(tools::wholeNumber("a number of renders (2 or more)"));
     render->add_flag("--stats", ro.stats,
                      "Print rays per ray type and depth, invocations per export, and the exclusive time per stage");
     render->add_option("--stats-json", ro.statsJson, "Write the --stats measures to FILE as JSON (format refray-stats/1)");
@@ -402,7 +408,8 @@ int main(int argc, char** argv) {
                        "of each pixel's primary ray, false-coloured, with a legend");
     render->add_option("--order-check", ro.orderCheck,
                        "Also render N seeded adversarial traversal orders (GEN-3) and write OUTPUT.order-mask.png: "
-                       "white where a pixel depends on the order");
+                       "white where a pixel depends on the order")
+        ->check(tools::wholeNumber("a number of adversarial orders (0: none)"));
 
     refray::tools::CompareCommandOptions compareOptions;
     CLI::App* compare = refray::tools::addCompareCommand(app, compareOptions);
@@ -424,8 +431,12 @@ int main(int argc, char** argv) {
     update->add_option("--dir", goldenDir, "Where the goldens go")->capture_default_str();
     update->add_option("--root", repositoryRoot, "The repository root (holds scenes/)")->capture_default_str();
     update->add_option("--size", goldenSize, "Golden size WIDTHxHEIGHT")->capture_default_str();
-    update->add_option("--order-check", goldenOrders, "Adversarial orders per golden")->capture_default_str();
-    update->add_option("--threads", goldenThreads, "Worker threads (0: all)")->capture_default_str();
+    update->add_option("--order-check", goldenOrders, "Adversarial orders per golden")
+        ->check(tools::wholeNumber("a number of adversarial orders per golden"))
+        ->capture_default_str();
+    update->add_option("--threads", goldenThreads, "Worker threads (0: all)")
+        ->check(tools::threadCount())
+        ->capture_default_str();
 
     try {
         app.parse(argc, argv);
@@ -454,7 +465,7 @@ int main(int argc, char** argv) {
             return 0;
         }
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        return refray::tools::parseErrorStatus(app, e);
     } catch (const refray::dxr::DxrError& e) {
         std::fprintf(stderr, "refray: %s\n", e.what());
         return 2;

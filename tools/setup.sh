@@ -8,6 +8,8 @@ packages=(
   libembree-dev libopenimageio-dev openimageio-tools libglm-dev libtbb-dev
   googletest libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libtinyobjloader-dev
+  libssl-dev  # OpenSSL's libcrypto: SHA-256 of scene files (core/hash.cpp)
+  libboost-dev  # Boost.Math (headers): Student's t distribution of 'refray compare --statistical'
   chromium  # the compare tool's HTML report is checked in headless Chromium
   fonts-dejavu-core  # legends of index maps (refray render --aov) are drawn with DejaVu Sans
   clang libclang-rt-14-dev  # libFuzzer programs (tools/fuzz.sh)

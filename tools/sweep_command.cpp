@@ -101,10 +101,13 @@ CLI::App* addSweepCommand(CLI::App& app, SweepCommandOptions& o) {
         ->default_str(scenes::kDefaultSweepReference);
     sweep->add_option("--camera", o.camera, "Camera name (default: the scene's defaultCamera)");
     sweep->add_option("--size", o.size, "Image size WIDTHxHEIGHT")->capture_default_str();
-    sweep->add_option("--time", o.time, "Animation time in seconds (default: the scene's)");
+    sweep->add_option("--time", o.time, "Animation time in seconds (default: the scene's)")->check(seconds());
     sweep->add_option("--threads", o.threads, "Worker threads of every render (0: all, fixed when planned)")
+        ->check(threadCount())
         ->capture_default_str();
-    sweep->add_option("--repeats", o.repeats, "Timed renders per setting (the median counts)")->capture_default_str();
+    sweep->add_option("--repeats", o.repeats, "Timed renders per setting (the median counts)")
+        ->check(wholeNumber("a number of timed renders, at least 1", 1))
+        ->capture_default_str();
     sweep->add_option("-o,--output", o.output, "The sweep directory")->capture_default_str();
     sweep->add_option("--emit-jobs", o.emitJobs, "Plan only: write one command line per setting to this file");
     sweep->add_option("--collect", o.collect, "Report only: merge the runs in this sweep directory");

@@ -13,6 +13,7 @@
 #include "core/json_writer.h"
 #include "core/strings.h"
 #include "scenes/scene.h"
+#include "tools/cli_common.h"
 
 namespace refray::tools {
 
@@ -414,7 +415,7 @@ CLI::App* addTableCommand(CLI::App& app, TableCommandOptions& o) {
     sub->footer(kFooter);
     sub->add_option("scene", o.scene, "Scene file (e.g. scenes/proceduray-mandel-julia-pac.json)")->required();
     sub->add_option("--precision", o.precision, "The shader library's precision (its state object and tables): float or double")
-        ->check(CLI::IsMember({"float", "double"}))
+        ->check(oneOf({"float", "double"}))
         ->capture_default_str();
     sub->add_flag("--json", o.json, "Print JSON instead of text");
     sub->add_flag("--check", o.check, "Exit with status 1 when there is an error-level finding");

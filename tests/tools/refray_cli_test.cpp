@@ -108,3 +108,72 @@ TEST(RefrayCli, SceneOptionsAreCheckedByName) {
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.output.find("cannot read scene file no-such-scene.json"), std::string::npos) << r.output;
 }
+
+// ---- Parse errors: exit status 2 and a message naming the command, the option and what it accepts ----
+
+namespace {
+
+void expectBadInput(const std::string& arguments, const std::string& message) {
+    const CliRun r = run(arguments);
+    EXPECT_EQ(r.status, 2) << "refray " << arguments << "\n" << r.output;
+    EXPECT_TRUE(refray::testing::contains(r.output, message)) << "refray " << arguments << "\n" << r.output;
+}
+
+}  // namespace
+
+TEST(RefrayCliParseErrors, RenderNamesTheOptionAndWhatItAccepts) {
+    expectBadInput("render builtin --spp -4", "refray render: --spp: expects a positive integer (a square number k*k; "
+                                              "for the path tracer any N), got '-4' (see 'refray render --help')");
+    expectBadInput("render builtin --time soon", "refray render: --time: expects a time in seconds, got 'soon'");
+}
+
+TEST(RefrayCliParseErrors, CompareNamesTheOptionAndWhatItAccepts) {
+    // 2 is also compare's FAILURE; the message tells them apart.
+    expectBadInput("compare ref.png mine.png --fail -1", "refray compare: --fail: expects a number >= 0, got '-1'");
+    expectBadInput("compare ref.png mine.png --channels rbg",
+                   "refray compare: --channels: expects rgb or rgba, got 'rbg' (did you mean 'rgb'?)");
+}
+
+TEST(RefrayCliParseErrors, GoldenUpdateNamesTheOptionAndWhatItAccepts) {
+    expectBadInput("golden update --threads many",
+                   "refray golden update: --threads: expects a number of worker threads (0: all), got 'many'");
+}
+
+TEST(RefrayCliParseErrors, TableNamesTheOptionAndWhatItAccepts) {
+    expectBadInput("table scene.json --precision doubel",
+                   "refray table: --precision: expects float or double, got 'doubel' (did you mean 'double'?)");
+}
+
+TEST(RefrayCliParseErrors, ExplainNamesTheOptionAndWhatItAccepts) {
+    expectBadInput("explain scene.json --pixel 1,1 --seed -1",
+                   "refray explain: --seed: expects a seed from 0 to 18446744073709551615, got '-1'");
+}
+
+TEST(RefrayCliParseErrors, SweepNamesTheOptionAndWhatItAccepts) {
+    expectBadInput("sweep scene.json --knob steps=2 --repeats 0",
+                   "refray sweep: --repeats: expects a number of timed renders, at least 1, got '0'");
+}
+
+TEST(RefrayCliParseErrors, UnknownOptionsSuggestTheNearestOne) {
+    expectBadInput("render builtin --stat", "refray render: unknown option --stat (did you mean '--stats'?)");
+    expectBadInput("explain scene.json --pixle=1,1", "refray explain: unknown option --pixle (did you mean '--pixel'?)");
+}
+
+TEST(RefrayCliParseErrors, MissingAndExtraArgumentsAndSubcommands) {
+    expectBadInput("table", "refray table: scene is required");
+    expectBadInput("table a.json b.json", "refray table: unexpected argument 'b.json'");
+    expectBadInput("render builtin --spp", "refray render: --spp");
+    expectBadInput("rendr builtin", "refray: expects a subcommand (");
+    expectBadInput("rendr builtin", "got 'rendr' (did you mean 'render'?)");
+    expectBadInput("golden", "refray golden: expects a subcommand (update)");
+}
+
+TEST(RefrayCliParseErrors, HelpAndVersionStillExitZero) {
+    for (const char* command : {"--help", "render --help", "compare --help", "golden update --help", "table --help",
+                                "explain --help", "sweep --help"}) {
+        const CliRun r = run(command);
+        EXPECT_EQ(r.status, 0) << command << "\n" << r.output;
+        EXPECT_TRUE(refray::testing::contains(r.output, "Usage:")) << command << "\n" << r.output;
+    }
+    EXPECT_EQ(run("--version").status, 0);
+}
