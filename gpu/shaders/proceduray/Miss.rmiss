@@ -5,7 +5,7 @@
 #define PROCEDURAY_RMISS
 #include "proceduray/shader_compat.glsl"
 
-layout(location = 0) rayPayloadInEXT RayPayload rayPayload;
+layout(location = PROCEDURAY_INCOMING_RADIANCE_PAYLOAD_LOCATION) rayPayloadInEXT RayPayload rayPayload;
 
 //***************************************************************************
 //**********************------ Miss shaders -------**************************

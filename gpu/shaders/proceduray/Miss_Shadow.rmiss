@@ -4,7 +4,7 @@
 #define PROCEDURAY_RMISS
 #include "proceduray/shader_compat.glsl"
 
-layout(location = 1) rayPayloadInEXT ShadowRayPayload rayPayload;
+layout(location = PROCEDURAY_INCOMING_SHADOW_PAYLOAD_LOCATION) rayPayloadInEXT ShadowRayPayload rayPayload;
 
 // Raytracing.hlsl L26: static float gStep = 4.;
 const float gStep = 4.;

@@ -92,7 +92,7 @@ vec4 TraceRadianceRay(in Ray ray, in uint currentRayRecursionDepth)
         TraceRayParameters_HitGroup_GeometryStride,
         TraceRayParameters_MissShader_Offset[RayType_Radiance],
         rayDesc_Origin, rayDesc_TMin, rayDesc_Direction, rayDesc_TMax,
-        /*payload location*/ 0);
+        PROCEDURAY_RADIANCE_PAYLOAD_LOCATION);
 
     return tracedRayPayload.color;
 }
@@ -131,7 +131,7 @@ bool TraceShadowRayAndReportIfHit(in Ray ray, in uint currentRayRecursionDepth)
         TraceRayParameters_HitGroup_GeometryStride,
         TraceRayParameters_MissShader_Offset[RayType_Shadow],
         rayDesc_Origin, rayDesc_TMin, rayDesc_Direction, rayDesc_TMax,
-        /*payload location*/ 1);
+        PROCEDURAY_SHADOW_PAYLOAD_LOCATION);
 
     return shadowPayload.hit;
 }

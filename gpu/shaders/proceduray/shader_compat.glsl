@@ -18,9 +18,13 @@
 //   "Triangle":   l_materialCB @0 (PrimitiveConstantBuffer, 48 B: albedo @0, reflectanceCoef @16, diffuseCoef @20,
 //                 specularCoef @24, specularPower @28, stepScale @32, padding @36)
 //   "Procedural": l_materialCB @0 (48 B), l_aabbCB @48 (instanceIndex @48, primitiveType @52); 56 B in all
-// Ray payloads (locations are this library's choice):
-//   location 0  RayPayload        {vec4 color; uint recursionDepth; float dist; int count; bool hit;}  32 B
-//   location 1  ShadowRayPayload  {float dist; bool hit;}                                               8 B
+// Ray payloads (locations are this library's choice; a location only names a variable inside one stage, the
+// payload a shader receives is the one its caller traced with):
+//   RayPayload        {vec4 color; uint recursionDepth; float dist; int count; bool hit;}  32 B
+//                     outgoing (rayPayloadEXT, rgen/rchit) location 0, incoming (rayPayloadInEXT) location 2
+//   ShadowRayPayload  {float dist; bool hit;}                                               8 B
+//                     outgoing (rchit) location 1, incoming (Miss_Shadow) location 3
+//   (glslang refuses a rayPayloadInEXT and a rayPayloadEXT at one location, hence the separate incoming ones.)
 // Hit attributes: ProceduralPrimitiveAttributes {vec3 normal; vec4 color;} = 28 B (triangles: built-in barycentrics).
 // TraceRay: radiance = (flags CULL_BACK_FACING_TRIANGLES, mask 0xFF, R 0, M 2, miss 0, TMin 0, TMax 10000);
 //           shadow   = (CULL_BACK | TERMINATE_ON_FIRST_HIT | OPAQUE | SKIP_CLOSEST_HIT, 0xFF, R 1, M 2, miss 1, 0, 10000).
@@ -203,11 +207,15 @@ layout(shaderRecordEXT, scalar) buffer ProceduralRootArguments
 
 // ---- Ray payloads this library traces with (see the table above) ---------------------------------------------------
 // PORT: HLSL's TraceRay takes a local payload; GLSL's traceRayEXT names a rayPayloadEXT variable by location.
+#define PROCEDURAY_RADIANCE_PAYLOAD_LOCATION 0
+#define PROCEDURAY_SHADOW_PAYLOAD_LOCATION 1
+#define PROCEDURAY_INCOMING_RADIANCE_PAYLOAD_LOCATION 2
+#define PROCEDURAY_INCOMING_SHADOW_PAYLOAD_LOCATION 3
 #if defined(PROCEDURAY_RGEN) || defined(PROCEDURAY_RCHIT)
-layout(location = 0) rayPayloadEXT RayPayload tracedRayPayload;
+layout(location = PROCEDURAY_RADIANCE_PAYLOAD_LOCATION) rayPayloadEXT RayPayload tracedRayPayload;
 #endif
 #if defined(PROCEDURAY_RCHIT)
-layout(location = 1) rayPayloadEXT ShadowRayPayload shadowPayload;
+layout(location = PROCEDURAY_SHADOW_PAYLOAD_LOCATION) rayPayloadEXT ShadowRayPayload shadowPayload;
 #endif
 
 #endif // PROCEDURAY_SHADER_COMPAT_GLSL
