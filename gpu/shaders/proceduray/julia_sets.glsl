@@ -64,7 +64,9 @@ vec2 jdist(in vec3 p, in vec4 c, in int iMax)
 // PORT: GLSL has no default arguments; the one-argument overload below passes the HLSL's defaults (kc, 200).
 vec3 calcNormal(in vec3 pos, in vec4 c, in int iMax)
 {
-    const vec2 e = vec2(1.0f, -1.0f) * 0.5773f * kPrecis;
+    // PORT: HLSL `float2(1.0f, -1.0f) * 0.5773f * kPrecis` multiplies in float (DXC): 0.5773f * 0.00025f =
+    // 0.000144325008. glslang folds it in double (0.000144324993, one float ulp less), so the product is spelled out.
+    const vec2 e = vec2(1.0f, -1.0f) * 0.000144325008f;
 
     return normalize(
         e.xyy * jdist(pos + e.xyy, c, iMax).x +

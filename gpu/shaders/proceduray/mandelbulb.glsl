@@ -42,7 +42,9 @@ float mdist( in vec3 p, out vec4 resColor )
 vec3 calcNormal( in vec3 pos, in float t )
 {
     vec4 tmp;
-    vec2 e = vec2(1.0,-1.0)*0.5773 * 0.0001;
+    // PORT: HLSL `float2(1.0,-1.0)*0.5773 * 0.0001` multiplies in float (DXC): 0.5773f * 0.0001f = 5.77299979e-05.
+    // glslang folds 0.5773 * 0.0001 in double (5.77300016e-05, one float ulp more), so the float product is spelled out.
+    vec2 e = vec2(1.0,-1.0)*5.77299979e-05;
     return normalize( e.xyy*mdist( pos + e.xyy,tmp ) +
                       e.yyx*mdist( pos + e.yyx,tmp ) +
                       e.yxy*mdist( pos + e.yxy,tmp ) +

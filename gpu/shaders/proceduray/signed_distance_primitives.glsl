@@ -98,7 +98,9 @@ float GetDistanceFromSignedDistancePrimitive(in vec3 position, in uint signedDis
 
 vec3 sdCalculateNormal(in vec3 pos, in uint sdPrimitive, in float time)
 {
-    vec2 e = vec2(1.0, -1.0) * 0.5773 * 0.0001;
+    // PORT: HLSL `float2(1.0, -1.0) * 0.5773 * 0.0001` multiplies in float (DXC): 0.5773f * 0.0001f = 5.77299979e-05.
+    // glslang folds 0.5773 * 0.0001 in double (5.77300016e-05, one float ulp more), so the float product is spelled out.
+    vec2 e = vec2(1.0, -1.0) * 5.77299979e-05;
     return normalize(
         e.xyy * GetDistanceFromSignedDistancePrimitive(pos + e.xyy, sdPrimitive, time) +
         e.yyx * GetDistanceFromSignedDistancePrimitive(pos + e.yyx, sdPrimitive, time) +
