@@ -12,7 +12,7 @@
 #define LOCAL_ROOT_SIGNATURE_AABB
 #include "d3d12-procedural-geometry/Raytracing.glsl"
 
-layout(location = PAYLOAD_LOCATION_RADIANCE) rayPayloadInEXT RayPayload rayPayload;
+rayPayloadInEXT RayPayload rayPayload;
 hitAttributeEXT ProceduralPrimitiveAttributes attr;
 
 // [shader("closesthit")]

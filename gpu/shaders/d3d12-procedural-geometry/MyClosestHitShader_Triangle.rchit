@@ -11,7 +11,7 @@
 #define LOCAL_ROOT_SIGNATURE_TRIANGLE
 #include "d3d12-procedural-geometry/Raytracing.glsl"
 
-layout(location = PAYLOAD_LOCATION_RADIANCE) rayPayloadInEXT RayPayload rayPayload;
+rayPayloadInEXT RayPayload rayPayload;
 
 // BuiltInTriangleIntersectionAttributes (unused, as in the HLSL).
 hitAttributeEXT vec2 barycentrics;

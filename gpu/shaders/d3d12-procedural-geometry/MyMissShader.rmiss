@@ -9,7 +9,7 @@
 #define DXR_STAGE_MISS
 #include "d3d12-procedural-geometry/Raytracing.glsl"
 
-layout(location = PAYLOAD_LOCATION_RADIANCE) rayPayloadInEXT RayPayload rayPayload;
+rayPayloadInEXT RayPayload rayPayload;
 
 //***************************************************************************
 //**********************------ Miss shaders -------**************************

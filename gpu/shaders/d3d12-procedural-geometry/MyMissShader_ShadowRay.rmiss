@@ -9,7 +9,7 @@
 #define DXR_STAGE_MISS
 #include "d3d12-procedural-geometry/Raytracing.glsl"
 
-layout(location = PAYLOAD_LOCATION_SHADOW) rayPayloadInEXT ShadowRayPayload rayPayload;
+rayPayloadInEXT ShadowRayPayload rayPayload;
 
 void main() // [shader("miss")] void MyMissShader_ShadowRay(inout ShadowRayPayload rayPayload)
 {

@@ -4,6 +4,8 @@
 // Payload locations of this library (the same in every shader of it):
 //   location 0: RayPayload        (radiance rays, 20 bytes: color at 0, recursionDepth at 16)
 //   location 1: ShadowRayPayload  (shadow rays, 4 bytes: hit at 0)
+// (The locations name the outgoing rayPayloadEXT variables of raygen and closest hit; an incoming rayPayloadInEXT
+// has none: Vulkan hands a shader the caller's payload, whose type must match.)
 // Hit attributes: ProceduralPrimitiveAttributes (12 bytes: normal at 0), HitKind always 0.
 #ifndef RAYTRACINGHLSLCOMPAT_GLSL
 #define RAYTRACINGHLSLCOMPAT_GLSL
