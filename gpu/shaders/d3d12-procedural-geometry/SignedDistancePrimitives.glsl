@@ -242,7 +242,10 @@ float sdCylinder6(vec3 p, vec2 h)
 
 vec3 sdCalculateNormal(in vec3 pos, in uint sdPrimitive)
 {
-    vec2 e = vec2(1.0, -1.0) * 0.5773 * 0.0001;
+    // PORT: DXC evaluates float2(1.0, -1.0) * 0.5773 * 0.0001 in float: 0.5773f * 0.0001f = 5.77299979e-05
+    // (0x3872231D). glslang folds the literal product in double (5.77300016e-05, 1 ulp away), so the float
+    // product is spelled as its bits.
+    vec2 e = vec2(1.0, -1.0) * uintBitsToFloat(0x3872231Du);
     return normalize(
         e.xyy * GetDistanceFromSignedDistancePrimitive(pos + e.xyy, sdPrimitive) +
         e.yyx * GetDistanceFromSignedDistancePrimitive(pos + e.yyx, sdPrimitive) +

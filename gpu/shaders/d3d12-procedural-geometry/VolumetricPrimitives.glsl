@@ -56,6 +56,8 @@ float CalculateMetaballsPotential(in vec3 position, in Metaball blobs[N_METABALL
 // Calculate a normal via central differences.
 vec3 CalculateMetaballsNormal(in vec3 position, in Metaball blobs[N_METABALLS], in uint nActiveMetaballs)
 {
+    // A literal-only product: folded at full precision, then rounded (DXC and glslang agree: 5.77299988e-06; the float
+    // product 0.5773f * 0.00001f happens to round to the same value).
     float e = 0.5773 * 0.00001;
     return normalize(vec3(
         CalculateMetaballsPotential(position + vec3(-e, 0, 0), blobs, nActiveMetaballs) -
