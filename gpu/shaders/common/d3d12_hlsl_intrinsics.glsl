@@ -66,6 +66,11 @@ float atan2(float y, float x) {
     return result;
 }
 
+// PORT: pow as DXC lowers it: exp2(y * log2(x)) (DXIL Log and Exp are base 2), for every exponent except a literal
+// 2 (x*x). GLSL pow leaves the lowering to the driver, which may expand constant integer exponents.
+// pow(0, y > 0) = 0, pow(0, 0) = NaN, pow(x < 0, y) = NaN.
+float hlsl_pow(float x, float y) { return exp2(y * log2(x)); }
+
 // PORT: smoothstep as DXC lowers it: s = saturate((x - min)/(max - min)), s*s*(3 - 2*s) (saturate maps NaN to 0).
 float hlsl_smoothstep(float minValue, float maxValue, float x) {
     float s = saturate((x - minValue) / (maxValue - minValue));

@@ -138,7 +138,7 @@ float CalculateDiffuseCoefficient(in vec3 hitPosition, in vec3 incidentLightRay,
 vec4 CalculateSpecularCoefficient(in vec3 hitPosition, in vec3 incidentLightRay, in vec3 normal, in float specularPower)
 {
     vec3 reflectedLightRay = normalize(reflect(incidentLightRay, normal));
-    return vec4(pow(saturate(dot(reflectedLightRay, normalize (-WorldRayDirection()))), specularPower));
+    return vec4(hlsl_pow(saturate(dot(reflectedLightRay, normalize (-WorldRayDirection()))), specularPower));
 }
 
 

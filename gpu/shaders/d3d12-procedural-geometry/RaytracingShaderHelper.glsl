@@ -146,7 +146,7 @@ float AnalyticalCheckersTexture(in vec3 hitPosition, in vec3 surfaceNormal, in v
 vec3 FresnelReflectanceSchlick(in vec3 I, in vec3 N, in vec3 f0)
 {
     float cosi = saturate(dot(-I, N));
-    return f0 + (1 - f0)*pow(1 - cosi, 5);
+    return f0 + (1 - f0)*hlsl_pow(1 - cosi, 5);
 }
 
 #endif // RAYTRACINGSHADERHELPER_GLSL

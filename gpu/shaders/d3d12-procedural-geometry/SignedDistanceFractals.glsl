@@ -41,6 +41,6 @@ float sdFractalPyramid(in vec3 position, vec3 h, in float Scale)
     float distance = sdPyramid(position, h);
 
     // Convert the distance from within a fractal iteration to the object space.
-    return distance * pow(Scale, float(-n));
+    return distance * hlsl_pow(Scale, float(-n));
 }
 #endif // SIGNEDDISTANCEFRACTALS_GLSL

@@ -214,13 +214,13 @@ float length_toPowNegative6(vec2 p)
 {
     p = p * p * p;
     p = p * p;
-    return pow(p.x + p.y, 1.0 / 6.0);
+    return hlsl_pow(p.x + p.y, 1.0 / 6.0);
 }
 
 float length_toPowNegative8(vec2 p)
 {
     p = p * p; p = p * p; p = p * p;
-    return pow(p.x + p.y, 1.0 / 8.0);
+    return hlsl_pow(p.x + p.y, 1.0 / 8.0);
 }
 
 float sdTorus82(vec3 p, vec2 t)
