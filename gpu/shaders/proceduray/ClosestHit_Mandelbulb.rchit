@@ -9,7 +9,7 @@
 layout(location = PROCEDURAY_INCOMING_RADIANCE_PAYLOAD_LOCATION) rayPayloadInEXT RayPayload rayPayload;
 hitAttributeEXT ProceduralPrimitiveAttributes attr;
 
-// PORT: HLSL clamp(x, 0.0, 1.0) is hlsl_clamp (NaN -> 0, as DXIL's FMax/FMin give; H7).
+// PORT: HLSL clamp(x, 0.0, 1.0) is hlsl_clamp (NaN -> 0, as DXIL's FMax/FMin give; H7); pow is hlsl_pow (DXC's exp2(y*log2(x))).
 void main() // [shader("closesthit")] void ClosestHit_Mandelbulb(inout RayPayload rayPayload, in ProceduralPrimitiveAttributes attr)
 {
     if (gl_HitKindEXT == 1)
@@ -22,7 +22,7 @@ void main() // [shader("closesthit")] void ClosestHit_Mandelbulb(inout RayPayloa
     vec3 col = vec3(0.01, 0.01, 0.01);
     col = mix( col, vec3(0.10,0.20,0.30), hlsl_clamp(attr.color.y,0.0,1.0) );
     col = mix( col, vec3(0.02,0.10,0.30), hlsl_clamp(attr.color.z*attr.color.z,0.0,1.0) );
-    col = mix( col, vec3(0.30,0.10,0.02), hlsl_clamp(pow(attr.color.w,6.0),0.0,1.0) );
+    col = mix( col, vec3(0.30,0.10,0.02), hlsl_clamp(hlsl_pow(attr.color.w,6.0),0.0,1.0) );
     col *= 0.5;
     //col = float3(0.1);
 
@@ -40,7 +40,7 @@ void main() // [shader("closesthit")] void ClosestHit_Mandelbulb(inout RayPayloa
     // sun
     float sha1 = 1.f;//softshadow( pos+0.001*nor, light1, 32.0 );
     float dif1 = hlsl_clamp( dot( light1, nor ), 0.0, 1.0 )*sha1;
-    float spe1 = pow( hlsl_clamp(dot(nor,hal),0.0,1.0), 32.0 )*dif1*(0.04+0.96*pow(hlsl_clamp(1.0-dot(hal,light1),0.0,1.0),5.0));
+    float spe1 = hlsl_pow( hlsl_clamp(dot(nor,hal),0.0,1.0), 32.0 )*dif1*(0.04+0.96*hlsl_pow(hlsl_clamp(1.0-dot(hal,light1),0.0,1.0),5.0));
     // bounce
     float dif2 = hlsl_clamp( 0.5 + 0.5*dot( light2, nor ), 0.0, 1.0 )*occ;
     // sky
@@ -53,7 +53,7 @@ void main() // [shader("closesthit")] void ClosestHit_Mandelbulb(inout RayPayloa
          lin += 2.5*vec3(0.35,0.30,0.25)*(0.05+0.95*occ); // ambient
          lin += 4.0*fac*occ;                          // fake SSS
     col *= lin;
-    col = pow( col, vec3(0.7,0.9,1.0) );                  // fake SSS
+    col = hlsl_pow( col, vec3(0.7,0.9,1.0) );                  // fake SSS
     col += spe1*15.0;
 
     // gamma

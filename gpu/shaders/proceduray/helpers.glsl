@@ -22,7 +22,8 @@ float CalculateDiffuseCoefficient(in vec3 hitPosition, in vec3 incidentLightRay,
 vec4 CalculateSpecularCoefficient(in vec3 hitPosition, in vec3 incidentLightRay, in vec3 normal, in float specularPower)
 {
     vec3 reflectedLightRay = normalize(reflect(incidentLightRay, normal));
-    return vec4(pow(saturate(dot(reflectedLightRay, normalize(-WorldRayDirection()))), specularPower));
+    // PORT: pow is hlsl_pow, DXC's exp2(y*log2(x)).
+    return vec4(hlsl_pow(saturate(dot(reflectedLightRay, normalize(-WorldRayDirection()))), specularPower));
 }
 
 // Phong lighting model = ambient + diffuse + specular components.

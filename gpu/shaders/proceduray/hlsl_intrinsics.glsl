@@ -15,6 +15,11 @@ vec3 hlsl_clamp(vec3 v, float lo, float hi)
     return vec3(hlsl_clamp(v.x, lo, hi), hlsl_clamp(v.y, lo, hi), hlsl_clamp(v.z, lo, hi));
 }
 
+// HLSL pow(x, y) as DXC lowers it (exponent other than the literal 2): exp2(y * log2(x)). So pow(0, y > 0) = 0,
+// pow(0, 0) = NaN and pow(x < 0, y) = NaN, where GLSL's pow leaves x <= 0 undefined and lets the driver choose.
+float hlsl_pow(float x, float y) { return exp2(y * log2(x)); }
+vec3 hlsl_pow(vec3 x, vec3 y) { return exp2(y * log2(x)); }
+
 // HLSL `float % float` (and fmod): the remainder with the sign of x, x - y * trunc(x / y). GLSL mod() floors
 // instead; for the non-negative times of the contract both agree, but this is the HLSL's definition.
 float hlsl_fmod(float x, float y) { return x - y * trunc(x / y); }

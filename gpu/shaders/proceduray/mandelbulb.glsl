@@ -1,5 +1,6 @@
 // Ports: dsilvavinicius/Proceduray@c849b6ba Proceduray/src/main_project/Mandelbulb.hlsli, mdist, calcNormal and
 // MandelbulbDistance (L1-117). PERFORMANCE is not defined in the HLSL, so the #else branch of mdist is the live one.
+// PORT: every pow is hlsl_pow, DXC's exp2(y*log2(x)) (hlsl_intrinsics.glsl).
 #ifndef PROCEDURAY_MANDELBULB_GLSL
 #define PROCEDURAY_MANDELBULB_GLSL
 
@@ -17,7 +18,7 @@ float mdist( in vec3 p, out vec4 resColor )
 
     for( int i=0; i<4; i++ )
     {
-        dz = 8.0*pow(sqrt(m),7.0)*dz + 1.0;
+        dz = 8.0*hlsl_pow(sqrt(m),7.0)*dz + 1.0;
         //dz = 8.0*pow(m,3.5)*dz + 1.0;
 
         float r = length(w);
@@ -25,7 +26,7 @@ float mdist( in vec3 p, out vec4 resColor )
         float b = 8.0*acos( w.y/r);
         // PORT: hlsl_atan2 is DXC's atan2 (atan2(0, 0) = pi/2, H5); GLSL atan(y, x) is undefined at (0, 0).
         float a = 8.0*hlsl_atan2( w.x, w.z );
-        w = p + pow(r,8.0) * vec3( sin(b)*sin(a), cos(b), sin(b)*cos(a) );
+        w = p + hlsl_pow(r,8.0) * vec3( sin(b)*sin(a), cos(b), sin(b)*cos(a) );
 
         trap = min( trap, vec4(abs(w),m) );
 

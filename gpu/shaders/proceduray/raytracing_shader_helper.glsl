@@ -122,7 +122,8 @@ Ray GenerateCameraRay(uvec2 index, in vec3 cameraPosition, in mat4 projectionToW
 vec3 FresnelReflectanceSchlick(in vec3 I, in vec3 N, in vec3 f0)
 {
     float cosi = saturate(dot(-I, N));
-    return f0 + (1.0 - f0) * pow(1.0 - cosi, 5.0);
+    // PORT: pow is hlsl_pow, DXC's exp2(y*log2(x)).
+    return f0 + (1.0 - f0) * hlsl_pow(1.0 - cosi, 5.0);
 }
 
 #endif // PROCEDURAY_RAYTRACING_SHADER_HELPER_GLSL
