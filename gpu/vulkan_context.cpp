@@ -67,15 +67,15 @@ int64_t computeQueueFamily(const VulkanFunctions& vk, VkPhysicalDevice device) {
 }
 
 // What `device` lacks of the requirements (empty: it qualifies).
-std::vector<std::string> missingRequirements(const VulkanFunctions& vk, VkPhysicalDevice device) {
+std::vector<std::string> missingRequirements(const VulkanFunctions& vk, VkPhysicalDevice device, bool rayTracing) {
     std::vector<std::string> missing;
     VkPhysicalDeviceProperties properties;
     vk.vkGetPhysicalDeviceProperties(device, &properties);
     if (properties.apiVersion < VK_API_VERSION_1_2)
         missing.push_back("Vulkan 1.2 (the device offers " + versionText(properties.apiVersion) + ")");
     const std::vector<VkExtensionProperties> extensions = deviceExtensions(vk, device);
-    bool allExtensions = true;
-    for (const std::string& name : requiredDeviceExtensions())
+    bool allExtensions = rayTracing;
+    for (const std::string& name : rayTracing ? requiredDeviceExtensions() : std::vector<std::string>{})
         if (!hasExtension(extensions, name)) {
             missing.push_back(name);
             allExtensions = false;
@@ -89,11 +89,12 @@ std::vector<std::string> missingRequirements(const VulkanFunctions& vk, VkPhysic
         if (!features.accelerationStructure.accelerationStructure)
             missing.push_back("the accelerationStructure feature");
         if (!features.rayTracingPipeline.rayTracingPipeline) missing.push_back("the rayTracingPipeline feature");
-    } else if (properties.apiVersion >= VK_API_VERSION_1_2) {
+    } else if (properties.apiVersion >= VK_API_VERSION_1_2 && (!rayTracing || !allExtensions)) {
         auto vulkan12 = vkStruct<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
         auto base = vkStruct<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &vulkan12);
         vk.vkGetPhysicalDeviceFeatures2(device, &base);
         if (!vulkan12.bufferDeviceAddress) missing.push_back("the bufferDeviceAddress feature");
+        if (!rayTracing && !vulkan12.scalarBlockLayout) missing.push_back("the scalarBlockLayout feature");
     }
     if (computeQueueFamily(vk, device) < 0) missing.push_back("a compute queue");
     return missing;
@@ -115,7 +116,7 @@ std::vector<std::string> requiredDeviceExtensions() {
             VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME};
 }
 
-VulkanContext::VulkanContext() {
+VulkanContext::VulkanContext(const VulkanContextOptions& options) : options_(options) {
     createInstance();
     chooseDevice();
     createDevice();
@@ -190,7 +191,7 @@ void VulkanContext::chooseDevice() {
     for (uint32_t i = 0; i < count; ++i) {
         VkPhysicalDeviceProperties properties;
         f.vkGetPhysicalDeviceProperties(devices[i], &properties);
-        const std::vector<std::string> missing = missingRequirements(f, devices[i]);
+        const std::vector<std::string> missing = missingRequirements(f, devices[i], options_.rayTracing);
         if (!missing.empty()) {
             report << "\n  device " << i << " '" << properties.deviceName << "' lacks " << joinedList(missing);
             continue;
@@ -218,7 +219,8 @@ void VulkanContext::createDevice() {
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR);
     auto accelerationStructure = vkStruct<VkPhysicalDeviceAccelerationStructurePropertiesKHR>(
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR, &rayTracing);
-    auto driver = vkStruct<VkPhysicalDeviceDriverProperties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES, &accelerationStructure);
+    auto driver = vkStruct<VkPhysicalDeviceDriverProperties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES,
+                                                             options_.rayTracing ? &accelerationStructure : nullptr);
     auto properties = vkStruct<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &driver);
     f.vkGetPhysicalDeviceProperties2(physicalDevice_, &properties);
     const VkPhysicalDeviceProperties& p = properties.properties;
@@ -246,10 +248,12 @@ void VulkanContext::createDevice() {
 
     // Features: the required ones, plus primitive culling where the device has it.
     FeatureChain available;
+    if (!options_.rayTracing) available.vulkan12.pNext = nullptr;  // no ray-tracing feature structs
     f.vkGetPhysicalDeviceFeatures2(physicalDevice_, &available.base);
     limits_.rayTraversalPrimitiveCulling = available.rayTracingPipeline.rayTraversalPrimitiveCulling == VK_TRUE;
     FeatureChain enabled;
-    enabled.base.features.shaderInt64 = VK_TRUE;
+    if (!options_.rayTracing) enabled.vulkan12.pNext = nullptr;
+    enabled.base.features.shaderInt64 = available.base.features.shaderInt64;
     enabled.vulkan12.bufferDeviceAddress = VK_TRUE;
     enabled.vulkan12.scalarBlockLayout = VK_TRUE;
     enabled.accelerationStructure.accelerationStructure = VK_TRUE;
@@ -261,7 +265,8 @@ void VulkanContext::createDevice() {
     queue.queueFamilyIndex = queueFamily_;
     queue.queueCount = 1;
     queue.pQueuePriorities = &priority;
-    const std::vector<std::string> extensionNames = requiredDeviceExtensions();
+    const std::vector<std::string> extensionNames =
+        options_.rayTracing ? requiredDeviceExtensions() : std::vector<std::string>{};
     std::vector<const char*> extensions;
     for (const std::string& e : extensionNames) extensions.push_back(e.c_str());
     auto info = vkStruct<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
@@ -271,7 +276,7 @@ void VulkanContext::createDevice() {
     info.enabledExtensionCount = uint32_t(extensions.size());
     info.ppEnabledExtensionNames = extensions.data();
     REFRAY_VK(f.vkCreateDevice(physicalDevice_, &info, nullptr, &device_));
-    loader_.loadDevice(device_);
+    loader_.loadDevice(device_, options_.rayTracing);
     f.vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
 
     auto pool = vkStruct<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);

@@ -43,12 +43,19 @@ struct RayTracingLimits {
 //   scalarBlockLayout, shaderInt64  the shaders' layout(scalar) blocks and uint64_t root descriptors
 std::vector<std::string> requiredDeviceExtensions();
 
+struct VulkanContextOptions {
+    // false: any Vulkan 1.2 device with bufferDeviceAddress, without the ray-tracing extensions (the entry points of
+    // VK_KHR_ray_tracing_pipeline and VK_KHR_acceleration_structure stay null). For testing buffers, images and
+    // descriptor sets on a software device such as lavapipe (tests/gpu/vulkan_memory_test.cpp).
+    bool rayTracing = true;
+};
+
 class VulkanContext {
 public:
     // Opens the loader, makes an instance and a device on the first physical device that has everything above.
     // Throws refray::Error saying exactly what is missing: the loader, a driver, a physical device, or a device
     // with ray tracing (naming each device and what it lacks).
-    VulkanContext();
+    explicit VulkanContext(const VulkanContextOptions& options = {});
     ~VulkanContext();
     VulkanContext(const VulkanContext&) = delete;
     VulkanContext& operator=(const VulkanContext&) = delete;
@@ -70,6 +77,7 @@ private:
     void chooseDevice();
     void createDevice();
 
+    VulkanContextOptions options_;
     VulkanLoader loader_;
     VkInstance instance_ = VK_NULL_HANDLE;
     VkPhysicalDevice physicalDevice_ = VK_NULL_HANDLE;

@@ -44,12 +44,15 @@ void VulkanLoader::loadInstance(VkInstance instance) {
 #undef REFRAY_VULKAN_LOAD_INSTANCE
 }
 
-void VulkanLoader::loadDevice(VkDevice device) {
+void VulkanLoader::loadDevice(VkDevice device, bool rayTracing) {
 #define REFRAY_VULKAN_LOAD_DEVICE(name)                                                              \
     functions_.name = reinterpret_cast<PFN_##name>(functions_.vkGetDeviceProcAddr(device, #name));  \
     REFRAY_CHECK(functions_.name, "the Vulkan device provides no " #name " (driver too old for Vulkan 1.2 with " \
                                   "VK_KHR_ray_tracing_pipeline and VK_KHR_acceleration_structure?)");
     REFRAY_VULKAN_DEVICE_FUNCTIONS(REFRAY_VULKAN_LOAD_DEVICE)
+    if (rayTracing) {
+        REFRAY_VULKAN_RAY_TRACING_FUNCTIONS(REFRAY_VULKAN_LOAD_DEVICE)
+    }
 #undef REFRAY_VULKAN_LOAD_DEVICE
 }
 

@@ -79,7 +79,9 @@ namespace refray::gpu {
     X(vkDestroyQueryPool)                            \
     X(vkCmdResetQueryPool)                           \
     X(vkCmdWriteTimestamp)                           \
-    X(vkGetQueryPoolResults)                         \
+    X(vkGetQueryPoolResults)
+
+#define REFRAY_VULKAN_RAY_TRACING_FUNCTIONS(X)       \
     X(vkCreateAccelerationStructureKHR)              \
     X(vkDestroyAccelerationStructureKHR)             \
     X(vkGetAccelerationStructureBuildSizesKHR)       \
@@ -96,6 +98,7 @@ struct VulkanFunctions {
     REFRAY_VULKAN_GLOBAL_FUNCTIONS(REFRAY_VULKAN_DECLARE)
     REFRAY_VULKAN_INSTANCE_FUNCTIONS(REFRAY_VULKAN_DECLARE)
     REFRAY_VULKAN_DEVICE_FUNCTIONS(REFRAY_VULKAN_DECLARE)
+    REFRAY_VULKAN_RAY_TRACING_FUNCTIONS(REFRAY_VULKAN_DECLARE)
 };
 
 // The shared library that holds the loader. Opens `REFRAY_VULKAN_LOADER` when that variable is set (a path or a
@@ -112,8 +115,9 @@ public:
     VulkanFunctions& functions() { return functions_; }
     const VulkanFunctions& functions() const { return functions_; }
     void loadInstance(VkInstance instance);
-    // Throws refray::Error naming the first device entry point the driver does not provide.
-    void loadDevice(VkDevice device);
+    // Throws refray::Error naming the first device entry point the driver does not provide; the ray-tracing ones
+    // only when `rayTracing`.
+    void loadDevice(VkDevice device, bool rayTracing = true);
     // What was opened: the file name given to dlopen.
     const std::string& libraryName() const { return name_; }
 
