@@ -4,16 +4,18 @@
 #
 #   .gpu-bundle/refray          the release binary (stripped)
 #   .gpu-bundle/shaders/        the compiled GLSL ports: <library>/<Export>.<stage>.spv
-#   .gpu-bundle/debs/*.deb      the Debian packages of the shared libraries refray loads (Embree, oneTBB,
-#                               OpenImageIO and what they load in turn), unpacked by tools/gpu_run.sh with
-#                               `dpkg -x` into .gpu-bundle/lib (never into /)
+#   .gpu-bundle/debs/*.deb      the Debian packages of the shared libraries refray uses (Embree, oneTBB,
+#                               OpenImageIO, OpenEXR, libpng, ...), unpacked by tools/gpu_run.sh with `dpkg -x`
+#                               into .gpu-bundle/lib (never into /)
+#   .gpu-bundle/stubs/*.so.*    stubs of the format libraries OpenImageIO links but refray never calls
+#                               (tools/gpu_bundle_libraries.py)
 #   .gpu-bundle/gl/*.deb        the Vulkan loader and the glvnd set the NVIDIA ICD needs, unpacked into / there
 #   .gpu-bundle/MANIFEST        what is in it, with sizes
 #
 # The packages travel as .debs (compressed) because unpacked they exceed what a device call carries (Embree
-# alone is 43 MB). Which packages travel: every package of a library in refray's `ldd` closure except the C and
-# C++ runtimes; with --target-ldconfig FILE (the output of `ldconfig -p` on the GPU machine, tools/gpu_run.sh
-# probe writes it) only those that provide a library the GPU machine lacks.
+# alone is 43 MB). With --target-ldconfig FILE (the output of `ldconfig -p` on the GPU machine, `tools/gpu_run.sh
+# probe` writes it) only packages of libraries the GPU machine lacks travel. Before it finishes, the script checks
+# that refray renders here from the bundle's libraries alone.
 #
 # Usage: bash tools/gpu_bundle.sh [--build-dir DIR] [--no-build] [--target-ldconfig FILE] [--max-mib N]
 set -euo pipefail
@@ -46,28 +48,52 @@ spirv="$build_dir/gpu/shaders"
 [ -d "$spirv" ] || { echo "gpu_bundle.sh: no $spirv: this build has no Vulkan back end (REFRAY_VULKAN)" >&2; exit 1; }
 
 rm -rf "$bundle"
-mkdir -p "$bundle/debs" "$bundle/gl" "$bundle/shaders"
+mkdir -p "$bundle/debs" "$bundle/gl" "$bundle/shaders" "$bundle/stubs"
 cp "$binary" "$bundle/refray"
 strip "$bundle/refray"
 (cd "$spirv" && find . -name '*.spv' -exec cp --parents {} "$bundle/shaders/" \;)
 
-# 2. The packages of refray's shared libraries: ldd's closure, by owning package.
+# 2. The libraries: those refray uses travel as their Debian packages; the format plug-ins OpenImageIO links but
+#    refray never calls (ffmpeg, OpenCV, DCMTK, OpenVDB, ...: 120 MiB of packages) as generated stubs
+#    (tools/gpu_bundle_libraries.py says which and why).
+python3 "$root/tools/gpu_bundle_libraries.py" "$binary" "$bundle"
 declare -A packages=()
-skip_re='^(libc6|libgcc-s1|libstdc\+\+6|libvulkan1|libglvnd0|libglx0|libgl1|libegl1|libopengl0|libgles2)$'
 while read -r soname path; do
-  [ -n "$path" ] || continue
-  pkg=$(dpkg -S "$(readlink -f "$path")" 2>/dev/null | head -1 | cut -d: -f1) || true
-  [ -n "$pkg" ] || { echo "gpu_bundle.sh: no package owns $path" >&2; continue; }
-  [[ "$pkg" =~ $skip_re ]] && continue
   if [ -n "$target_ldconfig" ] && grep -q "^[[:space:]]*$soname " "$target_ldconfig"; then
     continue  # the GPU machine has this library
   fi
+  # dpkg knows a file by the path its package installs (/lib or /usr/lib on a merged-/usr system).
+  real=$(readlink -f "$path")
+  pkg=""
+  for candidate in "$real" "${real#/usr}" "/usr${real}" "$path"; do
+    pkg=$(dpkg -S "$candidate" 2>/dev/null | head -1 | cut -d: -f1 || true)
+    [ -n "$pkg" ] && break
+  done
+  [ -n "$pkg" ] || { echo "gpu_bundle.sh: no package owns $path ($soname)" >&2; exit 1; }
   packages[$pkg]=1
-done < <(ldd "$binary" | awk '$2 == "=>" && $3 ~ /^\// {print $1, $3}')
+done < "$bundle/carried.txt"
+(cd "$bundle/debs" && apt-get download "${!packages[@]}" 2>&1 | grep -v '^W: Download is performed unsandboxed' || true)
+(cd "$bundle/gl" && apt-get download libvulkan1 libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2 2>&1 \
+   | grep -v '^W: Download is performed unsandboxed' || true)
 
-# apt-get download needs the package lists of the host's architecture.
-(cd "$bundle/debs" && apt-get download "${!packages[@]}" >/dev/null)
-(cd "$bundle/gl" && apt-get download libvulkan1 libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2 >/dev/null)
+# The check: refray runs from the packages and stubs alone, with no library of this machine but the C and C++
+# runtimes (the dynamic loader's cache off), and writes a PNG and an EXR.
+check=$(mktemp -d)
+trap 'rm -rf "$check"' EXIT
+mkdir -p "$check/root" "$check/lib" "$check/runtime"
+for f in "$bundle"/debs/*.deb; do dpkg -x "$f" "$check/root"; done
+find "$check/root" -name '*.so*' \( -type f -o -type l \) -exec ln -sf {} "$check/lib/" \;
+cp "$bundle"/stubs/*.so* "$check/lib/"
+for s in libc.so.6 libm.so.6 libdl.so.2 libpthread.so.0 librt.so.1 libstdc++.so.6 libgcc_s.so.1; do
+  ln -sf "/lib/x86_64-linux-gnu/$s" "$check/runtime/$s"
+done
+isolated=(/lib64/ld-linux-x86-64.so.2 --inhibit-cache --library-path "$check/lib:$check/runtime" "$bundle/refray")
+if ! "${isolated[@]}" render builtin --size 32x18 -o "$check/check.png" >/dev/null || \
+   ! "${isolated[@]}" render "$root/scenes/d3d12-procedural-geometry.json" --size 32x18 -o "$check/check.exr" >/dev/null; then
+  echo "gpu_bundle.sh: refray does not run from the bundle's libraries alone (above: what it lacked)" >&2
+  exit 1
+fi
+echo "checked: refray renders from the bundle's libraries and stubs alone"
 
 # 3. Manifest and size.
 {
@@ -75,6 +101,7 @@ done < <(ldd "$binary" | awk '$2 == "=>" && $3 ~ /^\// {print $1, $3}')
   echo "binary: $binary"
   echo "spirv modules: $(find "$bundle/shaders" -name '*.spv' | wc -l)"
   echo "target ldconfig: ${target_ldconfig:-none (every package of the closure)}"
+  echo "stubs (stubs/): $(cd "$bundle/stubs" && ls | tr '\n' ' ')"
   echo "packages (debs/):"
   (cd "$bundle/debs" && ls -1 *.deb | sed 's/^/  /')
   echo "loader (gl/):"

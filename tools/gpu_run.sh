@@ -7,8 +7,9 @@
 #   bash tools/gpu_run.sh ARGS...               refray ARGS... (any subcommand)
 #
 # It installs the Vulkan loader and the glvnd set into / (dpkg -x; as the device README says), unpacks the
-# library packages into .gpu-bundle/lib (never into /), puts that folder on LD_LIBRARY_PATH, prints the libraries
-# refray still lacks, and points refray at the bundle's SPIR-V. docs/vulkan-backend.md, "Running on the GPU
+# library packages into .gpu-bundle/unpacked and links into .gpu-bundle/lib (never into /) each library and stub the
+# machine lacks, puts that folder on LD_LIBRARY_PATH, prints the libraries refray still lacks, and points refray at
+# the bundle's SPIR-V. docs/vulkan-backend.md, "Running on the GPU
 # machine".
 set -uo pipefail
 
@@ -16,7 +17,7 @@ bundle="$(pwd)/.gpu-bundle"
 [ -x "$bundle/refray" ] || { echo "gpu_run.sh: no $bundle/refray; run tools/gpu_bundle.sh first, from the repository root" >&2; exit 2; }
 
 # The loader, into / (with libvulkan1 alone vkCreateInstance fails with VK_ERROR_INCOMPATIBLE_DRIVER).
-if ! ldconfig -p | grep -q 'libvulkan.so.1 '; then
+if ! ldconfig -p | grep 'libvulkan.so.1 ' >/dev/null; then
   for f in "$bundle"/gl/*.deb; do dpkg -x "$f" /; done
   ldconfig
 fi
@@ -30,11 +31,17 @@ fi
 # the system's own copies (same soname) win.
 if [ ! -d "$bundle/lib" ]; then
   mkdir -p "$bundle/unpacked" "$bundle/lib"
+  system_libraries=$(ldconfig -p)  # (grep -q on a pipe from ldconfig would fail under pipefail)
   for f in "$bundle"/debs/*.deb; do dpkg -x "$f" "$bundle/unpacked"; done
   while read -r file; do
     name=$(basename "$file")
-    if ! ldconfig -p | grep -q "^[[:space:]]*$name "; then ln -sf "$file" "$bundle/lib/$name"; fi
+    if ! grep -q "^[[:space:]]*$name " <<<"$system_libraries"; then ln -sf "$file" "$bundle/lib/$name"; fi
   done < <(find "$bundle/unpacked" -name '*.so.*' \( -type f -o -type l \))
+  # Stubs of the format libraries OpenImageIO links but refray never calls (tools/gpu_bundle_libraries.py).
+  for stub in "$bundle"/stubs/*.so*; do
+    name=$(basename "$stub")
+    if ! grep -q "^[[:space:]]*$name " <<<"$system_libraries"; then ln -sf "$stub" "$bundle/lib/$name"; fi
+  done
 fi
 export LD_LIBRARY_PATH="$bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export REFRAY_SPIRV_DIR="${REFRAY_SPIRV_DIR:-$bundle/shaders}"
