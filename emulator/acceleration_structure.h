@@ -134,6 +134,8 @@ public:
     ~BottomLevelAS();
     GpuVirtualAddress address() const { return address_; }
     uint32_t buildFlags() const { return buildFlags_; }
+    // The build inputs of the last build or update, as given (the GPU back end rebuilds from them).
+    const BottomLevelInputs& inputs() const { return inputs_; }
     const std::vector<BuiltGeometry>& geometries() const { return geometries_; }
     bool isTriangles() const { return !geometries_.empty() && geometries_[0].type == GeometryType::Triangles; }
     uint64_t generation() const { return generation_.load(); }

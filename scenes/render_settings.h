@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -15,6 +16,13 @@
 #include "procedural/precision.h"
 
 namespace refray::scenes {
+
+// Where DispatchRays runs: the same arguments as dxr::Device::dispatchRays, over the DXR state the scene built on
+// that device. Another back end (gpu/vulkan_dispatch.h: `refray render --device vulkan`) translates that state and
+// writes the render targets bound in the global root arguments, as the emulator does.
+using DispatchBackend =
+    std::function<dxr::DispatchResult(dxr::Device&, const dxr::DispatchRaysDesc&, const dxr::StateObjectPtr&,
+                                      const dxr::GlobalRootArguments*, const dxr::DispatchOptions&)>;
 
 struct RenderSettings {
     uint32_t width = 640;
@@ -46,6 +54,8 @@ struct RenderSettings {
     bool profileStages = false;
     // DispatchOptions::specialise: traversal shortcuts that change no result.
     bool specialise = true;
+    // Empty: the emulator runs the dispatch (dxr::Device::dispatchRays).
+    DispatchBackend backend;
 };
 
 // Runs DispatchRays for a width x height dispatch with the settings' threads, order, error mode and progress.
@@ -68,7 +78,8 @@ inline dxr::DispatchResult dispatchWithSettings(dxr::Device& device, const dxr::
         progress = std::make_unique<Progress>("render", launches, settings.progress);
         options.progress = progress.get();
     }
-    dxr::DispatchResult result = device.dispatchRays(desc, pipeline, globals, options);
+    dxr::DispatchResult result = settings.backend ? settings.backend(device, desc, pipeline, globals, options)
+                                                  : device.dispatchRays(desc, pipeline, globals, options);
     if (progress) progress->finish();
     return result;
 }

@@ -31,6 +31,7 @@
 #include "tools/cli_common.h"
 #include "tools/compare_command.h"
 #include "tools/explain_command.h"
+#include "tools/render_device.h"
 #include "tools/sweep_command.h"
 #include "tools/table_command.h"
 #include "tools/version.h"
@@ -179,6 +180,8 @@ struct RenderOptions {
     uint32_t orderCheck = 0;
     std::string aov;
     std::vector<std::string> knobs;  // "name=value"
+    std::string device = "cpu";      // --device: where DispatchRays runs (tools/render_device.h)
+    std::string spirvDir;            // --spirv-dir
 };
 
 // --aov: the index map with its legend beside it; the legend also goes to stdout.
@@ -265,6 +268,9 @@ int runRender(const RenderOptions& o) {
     settings.profileStages = (o.stats || !o.statsJson.empty()) && !o.noStageTimes;
     settings.specialise = !o.noShortcuts;
 
+    REFRAY_CHECK(o.device != "vulkan" || (o.aov.empty() && o.orderCheck == 0),
+                 "--device vulkan renders the image; --aov and --order-check need the emulator's trace and orders");
+    tools::RenderDevice device;  // --device: set once the scene's shader library is known
     scenes::RenderResult result;
     std::optional<StatisticsImage> statistics;  // --batches
     scenes::EffectSet effectSet;
@@ -276,6 +282,7 @@ int runRender(const RenderOptions& o) {
                      "--camera, --time, --spp, --precision, --knob, --order-check and --aov are for scene files");
         const Size size = parseSize(o.size.empty() ? "640x360" : o.size);
         settings.width = size.width, settings.height = size.height;
+        device = tools::useRenderDevice(o.device, "builtin", o.spirvDir, settings);
         scenes::BuiltinScene scene;
         const auto renderOnce = [&](const scenes::RenderSettings& s) {
             scenes::RenderResult r = scene.render(s);
@@ -292,6 +299,7 @@ int runRender(const RenderOptions& o) {
         effects = effectSet.list();
         const Size size = o.size.empty() ? Size{scene->desc().defaultWidth, scene->desc().defaultHeight} : parseSize(o.size);
         settings.width = size.width, settings.height = size.height;
+        device = tools::useRenderDevice(o.device, scene->desc().shaderLibrary, o.spirvDir, settings);
         if (!o.aov.empty()) {
             renderIndexMap(*scene, settings, o);
             return 0;
@@ -318,6 +326,7 @@ int runRender(const RenderOptions& o) {
         statistics->mean.metadata["refray_version"] = tools::kVersion;
         statistics->mean.metadata["refray_commit"] = tools::kCommit;
         statistics->mean.metadata["threads"] = std::to_string(o.threads);
+        for (const auto& [key, value] : device.provenance) statistics->mean.metadata[key] = value;
         const auto parent = std::filesystem::path(o.output).parent_path();
         if (!parent.empty()) std::filesystem::create_directories(parent);
         writeStatisticsImage(o.output, *statistics);
@@ -332,6 +341,7 @@ int runRender(const RenderOptions& o) {
         result.image.metadata["refray_commit"] = tools::kCommit;
         result.image.metadata["threads"] = std::to_string(o.threads);
         result.image.metadata["render_seconds"] = std::to_string(result.dispatch.seconds);
+        for (const auto& [key, value] : device.provenance) result.image.metadata[key] = value;
         writeOutput(o.output, result.image);
     }
     const Size renderedSize{result.image.width(), result.image.height()};
@@ -406,6 +416,13 @@ int main(int argc, char** argv) {
     render->add_option("--aov", ro.aov,
                        "Write an index map instead of the render: record|instance|geometry|primitive|hitgroup|depth "
                        "of each pixel's primary ray, false-coloured, with a legend");
+    render->add_option("--device", ro.device,
+                       "Where DispatchRays runs: cpu (the emulator) or vulkan (the same DXR state translated to a Vulkan "
+                       "ray-tracing GPU; docs/vulkan-backend.md)")
+        ->capture_default_str();
+    render->add_option("--spirv-dir", ro.spirvDir,
+                       "With --device vulkan: the folder of the compiled GLSL ports (<library>/<Export>.<stage>.spv); "
+                       "default $REFRAY_SPIRV_DIR, else next to the refray executable");
     render->add_option("--order-check", ro.orderCheck,
                        "Also render N seeded adversarial traversal orders (GEN-3) and write OUTPUT.order-mask.png: "
                        "white where a pixel depends on the order")

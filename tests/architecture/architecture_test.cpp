@@ -30,11 +30,12 @@ const std::map<std::string, std::set<std::string>>& allowedIncludes() {
         {"core", {}},
         {"emulator", {"core"}},
         {"procedural", {"core", "emulator"}},
+        {"gpu", {"core", "emulator"}},
         {"scenes", belowScenes},
         {"inspect", belowJobs},
         {"verify", belowJobs},
         {"study", belowJobs},
-        {"tools", {"core", "emulator", "procedural", "scenes", "inspect", "verify", "study"}},
+        {"tools", {"core", "emulator", "gpu", "procedural", "scenes", "inspect", "verify", "study"}},
     };
     return allowed;
 }

@@ -1,0 +1,83 @@
+// The state object as a Vulkan ray-tracing pipeline: one shader module per export, loaded from the compiled
+// GLSL port <spirv dir>/<library>/<Export>.<stage>.spv (gpu/shaders/CONTRACT.md); a general group per ray
+// generation, miss and callable export and a triangles or procedural hit group per DXR hit group, in the order of
+// StateObject::entries(), so group i's handle replaces the identifier of entry i; maxPipelineRayRecursionDepth =
+// the state object's MaxTraceRecursionDepth.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "emulator/state_object.h"
+#include "gpu/vulkan_context.h"
+#include "gpu/vulkan_shader_table.h"
+
+namespace refray::gpu {
+
+// "rgen", "rint", "rahit", "rchit", "rmiss", "rcall": the GLSL file extension of a stage.
+std::string_view stageExtension(dxr::ShaderStage stage);
+VkShaderStageFlagBits translateStage(dxr::ShaderStage stage);
+// <spirvDirectory>/<library>/<exportName>.<stage>.spv
+std::filesystem::path spirvPath(const std::filesystem::path& spirvDirectory, const std::string& library,
+                                const std::string& exportName, dxr::ShaderStage stage);
+
+// Shaders an AOV render puts in place of the library's (docs/vulkan-backend.md, "AOVs"): every hit group's
+// closest hit and every miss shader. Intersection and any-hit shaders stay, so the same hit is committed.
+struct AovShaders {
+    std::filesystem::path closestHit;  // records the committed hit; traces nothing
+    std::filesystem::path miss;        // does nothing
+    uint32_t recordIndexOffset = 0;    // specialization constant 0 of the closest hit
+};
+
+struct PipelineStage {
+    std::string exportName;
+    dxr::ShaderStage stage = dxr::ShaderStage::RayGeneration;
+    std::filesystem::path spirv;
+    bool aovClosestHit = false;  // gets the record-index offset as specialization constant 0
+};
+
+struct PipelineGroup {
+    std::string name;  // the export or hit group
+    VkRayTracingShaderGroupTypeKHR type = VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR;
+    uint32_t general = VK_SHADER_UNUSED_KHR;  // indices into PipelineShape::stages
+    uint32_t closestHit = VK_SHADER_UNUSED_KHR;
+    uint32_t anyHit = VK_SHADER_UNUSED_KHR;
+    uint32_t intersection = VK_SHADER_UNUSED_KHR;
+};
+
+struct PipelineShape {
+    std::vector<PipelineStage> stages;  // one per export used, each once
+    std::vector<PipelineGroup> groups;  // groups[i] is StateObject::entries()[i]
+    uint32_t maxRecursionDepth = 1;
+    uint32_t pipelineFlags = 0;  // the DXR pipeline flags (SKIP_TRIANGLES, SKIP_PROCEDURAL_PRIMITIVES)
+};
+
+// Pure: the stages and groups of `stateObject` (tests/gpu checks them without a GPU). No file is opened.
+PipelineShape describePipeline(const dxr::StateObject& stateObject, const std::filesystem::path& spirvDirectory,
+                               const std::string& library, const AovShaders* aov = nullptr);
+
+// The pipeline on the device, and the group handles in entry order.
+class RayTracingPipeline {
+public:
+    // Throws refray::Error naming the export and the file when a stage's SPIR-V is missing or unreadable, and when
+    // the recursion depth exceeds the device's maxRayRecursionDepth.
+    RayTracingPipeline(const VulkanContext& context, const PipelineShape& shape, VkPipelineLayout layout,
+                       uint32_t recordIndexOffset = 0);
+    ~RayTracingPipeline();
+    RayTracingPipeline(const RayTracingPipeline&) = delete;
+    RayTracingPipeline& operator=(const RayTracingPipeline&) = delete;
+
+    VkPipeline handle() const { return pipeline_; }
+    const std::vector<GroupHandle>& groupHandles() const { return handles_; }
+
+private:
+    const VulkanContext& context_;
+    VkPipeline pipeline_ = VK_NULL_HANDLE;
+    std::vector<GroupHandle> handles_;
+};
+
+}  // namespace refray::gpu

@@ -1,0 +1,16 @@
+# CTest: every compiled SPIR-V module under SPIRV_DIR passes spirv-val (SPIRV_VAL) for Vulkan 1.2.
+file(GLOB_RECURSE _modules ${SPIRV_DIR}/*.spv)
+list(LENGTH _modules _count)
+if(_count EQUAL 0)
+  message(FATAL_ERROR "no SPIR-V modules under ${SPIRV_DIR} (build the refray_spirv target)")
+endif()
+set(_failed 0)
+foreach(_module ${_modules})
+  execute_process(COMMAND ${SPIRV_VAL} --target-env vulkan1.2 ${_module} RESULT_VARIABLE _rc OUTPUT_VARIABLE _out
+                  ERROR_VARIABLE _out)
+  if(NOT _rc EQUAL 0)
+    message(SEND_ERROR "spirv-val rejects ${_module}:\n${_out}")
+    math(EXPR _failed "${_failed} + 1")
+  endif()
+endforeach()
+message(STATUS "${_count} SPIR-V modules checked, ${_failed} invalid")
