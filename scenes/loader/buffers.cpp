@@ -126,19 +126,17 @@ void parseGeneratedBuffers(ParseContext& ctx, const Value& value) {
     }
 }
 
-int32_t dataBuffer(const ParseContext& ctx, const Value& nameValue) {
-    std::vector<std::string> names;
-    for (const BufferDesc& b : ctx.scene.buffers) names.push_back(b.name);
-    const uint32_t i = resolveName(nameValue, names, "buffer");
-    if (!ctx.scene.buffers[i].isStatic())
-        nameValue.fail("buffer " + inQuotes(nameValue.asString()) + " is generated each frame; geometry needs a data buffer");
-    return int32_t(i);
-}
-
 int32_t dataOrGeneratedBuffer(const ParseContext& ctx, const Value& nameValue) {
     std::vector<std::string> names;
     for (const BufferDesc& b : ctx.scene.buffers) names.push_back(b.name);
     return int32_t(resolveName(nameValue, names, "buffer"));
+}
+
+int32_t dataBuffer(const ParseContext& ctx, const Value& nameValue) {
+    const int32_t i = dataOrGeneratedBuffer(ctx, nameValue);
+    if (!ctx.scene.buffers[size_t(i)].isStatic())
+        nameValue.fail("buffer " + inQuotes(nameValue.asString()) + " is generated each frame; geometry needs a data buffer");
+    return i;
 }
 
 }  // namespace refray::scenes::loader
