@@ -30,7 +30,8 @@ struct SignatureInfo {
     std::vector<ParameterInfo> parameters;
 };
 
-// The scene being filled in, and the names and values the parts read before it refer to them.
+// The scene being filled in, and what the parts read earlier keep for the parts after them (names to resolve,
+// struct layouts, the loaded models, where each record was written).
 struct ParseContext {
     explicit ParseContext(SceneDesc& sceneDesc) : scene(sceneDesc) {}
 
