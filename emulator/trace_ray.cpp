@@ -1,0 +1,298 @@
+// TraceRay (dxr-semantics.md sections 4-10): argument validation, the TLAS, candidate gathering and the TRV-4
+// loop, then the closest-hit or miss shader.
+#include "emulator/detail/trace_ray.h"
+
+#include <cmath>
+#include <cstring>
+#include <memory>
+
+#include "emulator/detail/candidate_gathering.h"
+#include "emulator/detail/candidate_processing.h"
+#include "emulator/detail/record_lookup.h"
+#include "emulator/detail/shader_invocation.h"
+#include "emulator/detail/thread_state.h"
+#include "emulator/detail/trace_events.h"
+#include "emulator/device.h"
+#include "emulator/limits.h"
+
+namespace refray::dxr::detail {
+
+namespace {
+
+void countRay(ThreadState& ts, RayTypeKey key, uint32_t depth) {
+    DispatchStats& st = ts.stats;
+    st.raysTraced++;
+    if (st.raysPerDepth.size() <= depth) st.raysPerDepth.resize(depth + 1);
+    st.raysPerDepth[depth]++;
+    RayTypeCounts* type = nullptr;
+    for (RayTypeCounts& t : st.raysPerType)
+        if (t.key == key) {
+            type = &t;
+            break;
+        }
+    if (!type) type = &st.raysPerType.emplace_back(RayTypeCounts{key, {}});
+    if (type->raysPerDepth.size() <= depth) type->raysPerDepth.resize(depth + 1);
+    type->raysPerDepth[depth]++;
+}
+
+std::string describeCallChain(const ThreadState& ts) {
+    std::string out;
+    for (const ShaderExport* s : ts.callChain) {
+        if (!out.empty()) out += " -> ";
+        out += std::string(toString(s->stage)) + " '" + s->name + "'";
+    }
+    return out;
+}
+
+// Embree's traversal accepts origin and direction components up to ±1.844e18 (its FLT_LARGE) and asserts
+// beyond; refray treats a finite ray beyond that like an infinite one (RAY-7: a warning, then a miss).
+constexpr float kTraversalRange = 1.844e18f;
+bool inTraversalRange(const RayDesc& ray) {
+    for (int c = 0; c < 3; ++c)
+        if (!(std::fabs(ray.Origin[c]) <= kTraversalRange && std::fabs(ray.Direction[c]) <= kTraversalRange)) return false;
+    return true;
+}
+
+std::string vec3Values(const vec3& v) {
+    return std::to_string(v.x) + "," + std::to_string(v.y) + "," + std::to_string(v.z);
+}
+
+void validateRay(ThreadState& ts, const Site& site, const RayDesc& ray, bool& ok) {
+    // inTraversalRange also fails for NaN and infinite components, so it covers their finiteness too.
+    if (inTraversalRange(ray) && std::isfinite(ray.TMin) && !std::isnan(ray.TMax) && ray.TMin >= 0.0f &&
+        ray.TMin <= ray.TMax && ray.Direction != vec3(0.0f))
+        return;  // the common case: nothing to report
+    auto field = [&](const char* name, float v) {
+        if (std::isnan(v)) {
+            raise(ts, site, diag("RAY-5", std::string("RayDesc.") + name + " is NaN").value(name, v));
+            ok = false;
+        }
+    };
+    for (int c = 0; c < 3; ++c) {
+        static const char* o[3] = {"Origin.x", "Origin.y", "Origin.z"};
+        static const char* d[3] = {"Direction.x", "Direction.y", "Direction.z"};
+        field(o[c], ray.Origin[c]);
+        field(d[c], ray.Direction[c]);
+    }
+    field("TMin", ray.TMin);
+    field("TMax", ray.TMax);
+    if (!ok) return;
+    if (ray.TMin < 0.0f) {
+        raise(ts, site, diag("RAY-5", "RayDesc.TMin is negative").value("TMin", ray.TMin, ">= 0"));
+        ok = false;
+    } else if (ray.TMin > ray.TMax) {
+        raise(ts, site, diag("RAY-5", "RayDesc.TMin is greater than TMax").value("TMin", ray.TMin).value("TMax", ray.TMax, ">= TMin"));
+        ok = false;
+    }
+    if (std::isinf(ray.TMin))
+        warn(ts, site, warning("RAY-5", "RayDesc.TMin is infinite; no hit can follow").value("TMin", ray.TMin));
+    if (ray.Direction == vec3(0.0f))
+        warn(ts, site, warning("RAY-7", "RayDesc.Direction is the zero vector"));
+    else if (!allFinite(ray.Origin) || !allFinite(ray.Direction))
+        warn(ts, site, warning("RAY-7", "RayDesc has an infinite Origin or Direction component")
+                           .value("Origin", vec3Values(ray.Origin))
+                           .value("Direction", vec3Values(ray.Direction)));
+    else if (!inTraversalRange(ray))
+        warn(ts, site, warning("RAY-7", "RayDesc has an Origin or Direction component beyond +-1.844e18, the range "
+                                        "refray's traversal (Embree) accepts; the ray is treated as a miss")
+                           .value("Origin", vec3Values(ray.Origin))
+                           .value("Direction", vec3Values(ray.Direction)));
+}
+
+// FLAG-2..5 on the effective flags; returns false (and has raised) when they are invalid.
+bool validateFlags(ThreadState& ts, const Site& site, uint32_t rayFlags, uint32_t pipelineFlags) {
+    const uint32_t eff = rayFlags | pipelineFlags;
+    auto fail = [&](const char* rule, const std::string& what) {
+        raise(ts, site, diag(rule, what)
+                            .value("TraceRay flags", rayFlagsToString(rayFlags))
+                            .value("pipeline flags", pipelineFlagsToString(pipelineFlags)));
+        return false;
+    };
+    const uint32_t opacity = eff & (RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_FORCE_NON_OPAQUE | RAY_FLAG_CULL_OPAQUE | RAY_FLAG_CULL_NON_OPAQUE);
+    if (opacity & (opacity - 1))
+        return fail(pipelineFlags ? "FLAG-5" : "FLAG-2",
+                    "at most one of FORCE_OPAQUE, FORCE_NON_OPAQUE, CULL_OPAQUE, CULL_NON_OPAQUE may be set");
+    if ((eff & RAY_FLAG_CULL_BACK_FACING_TRIANGLES) && (eff & RAY_FLAG_CULL_FRONT_FACING_TRIANGLES))
+        return fail(pipelineFlags ? "FLAG-5" : "FLAG-3", "CULL_BACK_FACING_TRIANGLES and CULL_FRONT_FACING_TRIANGLES are exclusive");
+    if ((eff & RAY_FLAG_SKIP_TRIANGLES) &&
+        (eff & (RAY_FLAG_CULL_BACK_FACING_TRIANGLES | RAY_FLAG_CULL_FRONT_FACING_TRIANGLES | RAY_FLAG_SKIP_PROCEDURAL_PRIMITIVES)))
+        return fail(pipelineFlags ? "FLAG-5" : "FLAG-4",
+                    "SKIP_TRIANGLES excludes CULL_*_FACING_TRIANGLES and SKIP_PROCEDURAL_PRIMITIVES");
+    return true;
+}
+
+}  // namespace
+
+void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags, uint32_t mask, uint32_t r,
+              uint32_t m, uint32_t missIndex, const RayDesc& ray, void* payload, TypeTag payloadType) {
+    ThreadState& ts = *caller.thread;
+    DispatchState& ds = *ts.dispatch;
+    const Site site = siteOf(caller);
+
+    if (caller.depth >= ds.pipeline->maxTraceRecursionDepth()) {  // LIM-2
+        raise(ts, site, diag("LIM-2", "TraceRay at the recursion limit: a call at depth == MaxTraceRecursionDepth removes the device")
+                            .value("depth", caller.depth, "< MaxTraceRecursionDepth " + std::to_string(ds.pipeline->maxTraceRecursionDepth()))
+                            .value("call chain", describeCallChain(ts)));
+        return;  // fallback: the call does nothing
+    }
+    if (rayFlags & ~kDefinedRayFlags) {  // RAY-10
+        raise(ts, site, diag("RAY-10", "TraceRay flags set undefined bits")
+                            .hex("RayFlags", rayFlags)
+                            .hex("undefined bits", rayFlags & ~kDefinedRayFlags));
+        rayFlags &= kDefinedRayFlags;
+    }
+    if (!validateFlags(ts, site, rayFlags, ds.pipeline->pipelineFlags())) return;
+    bool rayOk = true;
+    validateRay(ts, site, ray, rayOk);
+    if (!rayOk) return;
+    if ((r & ~kRayContributionMask) || (m & ~kGeometryMultiplierMask))  // IDX-2
+        warn(ts, site, warning("IDX-2", "TraceRay index arguments have bits above the low 4; DXR ignores them")
+                           .value("RayContributionToHitGroupIndex", r, "0..15")
+                           .value("MultiplierForGeometryContributionToHitGroupIndex", m, "0..15"));
+
+    RayState rs;
+    rs.ray = ray;
+    rs.rayFlags = rayFlags;
+    rs.effectiveFlags = rayFlags | ds.pipeline->pipelineFlags();
+    rs.instanceInclusionMask = mask & kInstanceInclusionMaskBits;
+    rs.rayContribution = r;
+    rs.multiplier = m;
+    rs.missShaderIndex = missIndex;
+    rs.depth = caller.depth + 1;
+    rs.tCurrent = ray.TMax;
+    rs.payloadType = payloadType;
+
+    // RAY-9: the payload is passed by value.
+    alignas(16) uint8_t inlinePayload[256];
+    std::unique_ptr<uint8_t[]> heapPayload;
+    uint8_t* local = inlinePayload;
+    if (payloadType.size > sizeof inlinePayload) {
+        heapPayload.reset(new uint8_t[payloadType.size]);
+        local = heapPayload.get();
+    }
+    std::memcpy(local, payload, payloadType.size);
+    rs.payload = local;
+    auto emitRay = [&](TraceEvent::Kind kind) {
+        TraceEvent e = event(ts, kind, rs.depth);
+        e.accelerationStructure = asAddress;
+        e.ray = ray;
+        e.rayFlags = rayFlags;
+        e.effectiveFlags = rs.effectiveFlags;
+        e.instanceInclusionMask = mask;
+        e.rayContribution = r;
+        e.multiplier = m;
+        e.missShaderIndex = missIndex;
+        e.committed = rs.committed;
+        if (rs.committed) {
+            const HitInfo& h = rs.committedHit;
+            setHit(e, *h.instance, h.instanceIndex, h.geometryIndex, h.primitiveIndex);
+            e.t = h.t;
+            e.hitKind = h.hitKind;
+        }
+        if (kind == TraceEvent::Kind::TraceRayEnd && rs.committed && (rs.effectiveFlags & RAY_FLAG_SKIP_CLOSEST_HIT_SHADER))
+            e.note = "closest hit skipped: SKIP_CLOSEST_HIT_SHADER (FLAG-9)";
+        e.payloadTypeId = payloadType.id;
+        e.payloadTypeName = payloadType.mangledName;
+        e.payload = local;
+        e.payloadSize = payloadType.size;
+        observer(ts)->onEvent(e);
+    };
+    if (observer(ts)) emitRay(TraceEvent::Kind::TraceRay);
+
+    countRay(ts, {r & kRayContributionMask, missIndex & kMissShaderIndexMask}, rs.depth);
+    ts.rayCounter++;
+
+    // RAY-7: an infinite origin or direction component makes the plain math NaN, so the ray finds nothing;
+    // components beyond Embree's range get the same treatment. Embree never sees either kind of ray.
+    const bool traceable = inTraversalRange(ray);  // false for NaN and infinite components too
+    if (asAddress != 0 && traceable) {
+        if (asAddress != ts.lastTlasAddress) {
+            ts.lastTlas = ds.device->findTopLevelAS(asAddress);
+            ts.lastTlasAddress = ts.lastTlas ? asAddress : 0;
+        }
+        rs.tlas = ts.lastTlas;
+        if (!rs.tlas) {
+            const bool isBottom = ds.device->findBottomLevelAS(asAddress) != nullptr;
+            raise(ts, site, diag(isBottom ? "INST-10" : "RAY-1",
+                                 isBottom ? "TraceRay was given a BLAS; it needs a TLAS"
+                                          : "TraceRay was given an address that is not an acceleration structure")
+                                .hex("AccelerationStructure", asAddress));
+            return;
+        }
+        if (rs.tlas->checkedEpoch() != ds.epoch) {  // INST-8
+            for (size_t i = 0; i < rs.tlas->instances().size(); ++i) {
+                const BuiltInstance& inst = rs.tlas->instances()[i];
+                if (inst.blas && inst.blas->generation() != inst.blasGeneration) {
+                    raise(ts, site, diag("INST-8", "the TLAS was not rebuilt or updated after a BLAS it references was updated")
+                                        .value("InstanceIndex", i)
+                                        .hex("BLAS", inst.blas->address()));
+                    return;
+                }
+            }
+            rs.tlas->markChecked(ds.epoch);
+        }
+
+        // Gather (Embree broad phase + exact tests), order (GEN-3), then TRV-4 per candidate.
+        gatherOrderedCandidates(ts, rs, site);
+        // Nested TraceRays (from the CHS below) reuse ts.candidates: iterate over a copy only
+        // while shaders of this ray may run, which ends before the CHS starts.
+        for (size_t i = 0; i < ts.candidates.size() && !rs.searchEnded; ++i) {
+            const Candidate c = ts.candidates[i];
+            if (observer(ts)) {
+                TraceEvent e = event(ts, TraceEvent::Kind::Candidate, rs.depth);
+                setHit(e, rs.tlas->instances()[c.instanceIndex], c.instanceIndex, c.geometryIndex, c.primitiveIndex);
+                e.procedural = c.procedural;
+                e.t = c.procedural ? c.key : c.t;
+                observer(ts)->onEvent(e);
+            }
+            processCandidate(ts, rs, c, site);
+        }
+    }
+
+    // TRV-5, TRV-6: at most one CHS or one miss shader.
+    if (rs.committed) {
+        if (!(rs.effectiveFlags & RAY_FLAG_SKIP_CLOSEST_HIT_SHADER)) {  // FLAG-9
+            const HitInfo& hit = rs.committedHit;
+            const HitGroupIndexTerms terms =
+                hitGroupRecordIndex(r, m, hit.geometryIndex, hit.instance->desc.InstanceContributionToHitGroupIndex);
+            const BuiltGeometry& geom = hit.instance->blas->geometries()[hit.geometryIndex];
+            HitLookupContext lookup{&terms, &hit, geom.type};
+            RecordView record;
+            if (lookupRecord(ts, site, ProgramEntry::Kind::HitGroup, ds.desc->HitGroupTable, terms.index, record, &lookup) &&
+                record.entry && record.entry->closestHit) {
+                Invocation inv;
+                inv.stage = ShaderStage::ClosestHit;
+                inv.shader = record.entry->closestHit;
+                inv.record = &record;
+                inv.ray = &rs;
+                inv.hit = &rs.committedHit;
+                inv.dispatch = &ds;
+                inv.thread = &ts;
+                inv.depth = rs.depth;
+                checkGlobalSignature(ts, siteOf(inv), *record.entry);
+                checkPayload(ts, siteOf(inv), *inv.shader, payloadType);
+                invoke(ts, inv, rs.payload, rs.committedHit.attributes);
+            }
+        }
+    } else {
+        RecordView record;
+        if (lookupRecord(ts, site, ProgramEntry::Kind::Miss, ds.desc->MissShaderTable, missRecordIndex(missIndex), record) &&
+            record.entry) {
+            Invocation inv;
+            inv.stage = ShaderStage::Miss;
+            inv.shader = record.entry->shader;
+            inv.record = &record;
+            inv.ray = &rs;
+            inv.dispatch = &ds;
+            inv.thread = &ts;
+            inv.depth = rs.depth;
+            checkGlobalSignature(ts, siteOf(inv), *record.entry);
+            checkPayload(ts, siteOf(inv), *inv.shader, payloadType);
+            invoke(ts, inv, rs.payload, nullptr);
+        }
+    }
+    if (observer(ts)) emitRay(TraceEvent::Kind::TraceRayEnd);
+    std::memcpy(payload, local, payloadType.size);
+}
+
+}  // namespace refray::dxr::detail
