@@ -17,24 +17,11 @@
 
 namespace refray::dxr {
 
-namespace detail {
-
-// The thread's statistics in DispatchStats form (raysPerType stays unsorted: merge sorts).
-DispatchStats finishedStats(const ThreadState& ts) {
-    DispatchStats st = ts.stats;
-    for (const ExportCount& e : ts.exportCounts) st.invocationsPerExport.push_back({e.shader->name, e.shader->stage, e.count});
-    st.stagesProfiled = ts.profiling;
-    if (ts.profiling)
-        for (size_t i = 0; i < kProfileStageCount; ++i) st.stageSeconds[i] = std::chrono::duration<double>(ts.clock.spent[i]).count();
-    return st;
-}
-
-}  // namespace detail
-
-// ---------------------------------------------------------------------------------------
-// DispatchRays.
-
 namespace {
+
+using detail::DispatchState;
+using detail::ThreadState;
+using ThreadStates = tbb::enumerable_thread_specific<ThreadState>;
 
 // Locks every table the dispatch reads for its whole duration (REC-12).
 class TableLock {
@@ -64,17 +51,15 @@ void checkTableRange(const char* name, GpuVirtualAddress start, uint64_t size, u
                            .value("StrideInBytes", stride, "multiple of 32, <= 4096"));
 }
 
-}  // namespace
-
-DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObjectPtr& pipeline,
-                                    const GlobalRootArguments* globalArguments, const DispatchOptions& options) {
-    const auto start = std::chrono::steady_clock::now();
+// RGS-3, RGS-1, REC-2, REC-3, IDX-11: what DispatchRays is given, before anything runs. `launches` is
+// Width*Height*Depth.
+void checkDispatchDesc(const DispatchRaysDesc& desc, const StateObjectPtr& pipeline, uint64_t launches,
+                       const GpuMemory& memory) {
     if (!pipeline)
         throw DxrError(diag("RGS-3", "DispatchRays without a bound ray-tracing pipeline state object"));
-    const uint64_t threads = uint64_t(desc.Width) * desc.Height * desc.Depth;
-    if (threads > kMaxRayGenerationShaderThreads)
+    if (launches > kMaxRayGenerationShaderThreads)
         throw DxrError(diag("RGS-1", "DispatchRays launches too many threads")
-                           .value("Width*Height*Depth", threads, std::to_string(kMaxRayGenerationShaderThreads))
+                           .value("Width*Height*Depth", launches, std::to_string(kMaxRayGenerationShaderThreads))
                            .value("Width", desc.Width)
                            .value("Height", desc.Height)
                            .value("Depth", desc.Depth));
@@ -90,11 +75,15 @@ DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObj
                                std::pair{"HitGroupTable", GpuVirtualAddressRange{desc.HitGroupTable.StartAddress, desc.HitGroupTable.SizeInBytes}},
                                std::pair{"CallableShaderTable", GpuVirtualAddressRange{desc.CallableShaderTable.StartAddress, desc.CallableShaderTable.SizeInBytes}},
                                std::pair{"RayGenerationShaderRecord", desc.RayGenerationShaderRecord}}) {
-        if (range.SizeInBytes && !memory_.find(range.StartAddress, range.SizeInBytes))
+        if (range.SizeInBytes && !memory.find(range.StartAddress, range.SizeInBytes))
             throw DxrError(diag("IDX-11", std::string(name) + " range is not inside one GPU buffer")
                                .hex("StartAddress", range.StartAddress)
                                .value("SizeInBytes", range.SizeInBytes));
     }
+}
+
+// The launch indices that run: DispatchOptions::region, which must lie inside the dispatch, or all of them.
+LaunchRegion launchRegion(const DispatchRaysDesc& desc, const DispatchOptions& options) {
     LaunchRegion region{0, 0, desc.Width, desc.Height};
     if (options.region) {
         region = *options.region;
@@ -103,11 +92,128 @@ DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObj
                                           << region.y << ") is not inside the " << desc.Width << "x" << desc.Height
                                           << " dispatch");
     }
+    return region;
+}
+
+// PIPE-7: the root signature bound for the dispatch must be a global one.
+void checkGlobalArguments(const GlobalRootArguments* globalArguments) {
     if (globalArguments && globalArguments->signature()->isLocal())
         throw DxrError(diag("PIPE-7", "the root signature bound for the dispatch is a local root signature")
                            .value("signature", globalArguments->signature()->name()));
+}
 
-    detail::DispatchState ds;
+// The ray generation record (IDX-9, IDX-13), resolved once for every thread into ds.rayGenRecord. Its errors
+// always stop the dispatch, whatever DispatchOptions::onError says.
+void resolveRayGenerationRecord(DispatchState& ds) {
+    ThreadState probe;
+    probe.dispatch = &ds;
+    const detail::Site site{ShaderStage::RayGeneration, &detail::kNoExport, 0};
+    const OnError onError = ds.options.onError;
+    ds.options.onError = OnError::Stop;
+    const GpuVirtualAddressRangeAndStride rg{ds.desc->RayGenerationShaderRecord.StartAddress,
+                                             ds.desc->RayGenerationShaderRecord.SizeInBytes, 0};
+    if (rg.StartAddress == 0 || rg.SizeInBytes < kShaderIdentifierSizeInBytes)
+        throw DxrError(diag("IDX-9", "RayGenerationShaderRecord must hold at least the 32-byte identifier")
+                           .hex("StartAddress", rg.StartAddress)
+                           .value("SizeInBytes", rg.SizeInBytes, ">= 32"));
+    detail::lookupRecord(probe, site, ProgramEntry::Kind::RayGeneration, rg, 0, ds.rayGenRecord);
+    ds.options.onError = onError;
+}
+
+// The launch index in Width-major, then Height, then Depth order: the order GEN-1 calls "first".
+uint64_t linearIndex(const DispatchRaysDesc& desc, uvec3 launch) {
+    return (uint64_t(launch.z) * desc.Height + launch.y) * desc.Width + launch.x;
+}
+
+// OnError::Stop: keeps the error that ended this launch; launches after the first failed one are skipped.
+void recordStopError(ThreadState& ts, DispatchState& ds, Diagnostic d) {
+    ts.stopErrors.push_back(std::move(d));
+    uint64_t seen = ds.firstErrorIndex.load();
+    while (ts.linearIndex < seen && !ds.firstErrorIndex.compare_exchange_weak(seen, ts.linearIndex)) {
+    }
+}
+
+// One launch: the ray generation shader at `launch`, unless an earlier launch has stopped the dispatch.
+void runLaunch(ThreadState& ts, DispatchState& ds, uvec3 launch) {
+    ts.launchIndex = launch;
+    ts.linearIndex = linearIndex(*ds.desc, launch);
+    if (ts.linearIndex > ds.firstErrorIndex.load(std::memory_order_relaxed)) return;
+    ts.rayCounter = 0;
+    detail::Invocation inv;
+    inv.stage = ShaderStage::RayGeneration;
+    inv.shader = ds.rayGenRecord.entry->shader;
+    inv.record = &ds.rayGenRecord;
+    inv.dispatch = &ds;
+    inv.thread = &ts;
+    inv.depth = 0;
+    try {
+        detail::checkGlobalSignature(ts, detail::siteOf(inv), *ds.rayGenRecord.entry);
+        detail::invoke(ts, inv, nullptr, nullptr);
+    } catch (const DxrError& e) {
+        recordStopError(ts, ds, e.diagnostic());
+    } catch (const Error& e) {
+        recordStopError(ts, ds, detail::locate(ts, diag("GEN-1", e.what()), detail::siteOf(inv)));
+    }
+}
+
+// Every launch of `region` at every depth, over oneTBB tiles of DispatchOptions::tileSize on
+// DispatchOptions::threads workers.
+void runTiles(DispatchState& ds, const LaunchRegion& region, ThreadStates& threadStates) {
+    const DispatchOptions& options = ds.options;
+    const uint32_t tile = std::max(1u, options.tileSize);
+    const int arenaThreads = options.threads ? int(options.threads) : tbb::task_arena::automatic;
+    tbb::task_arena arena(arenaThreads);
+    arena.execute([&] {
+        tbb::parallel_for(
+            tbb::blocked_range2d<uint32_t>(region.y, region.y + region.height, tile, region.x, region.x + region.width, tile),
+            [&](const tbb::blocked_range2d<uint32_t>& range) {
+                ThreadState& ts = threadStates.local();
+                for (uint32_t z = 0; z < ds.desc->Depth; ++z)
+                    for (uint32_t y = range.rows().begin(); y < range.rows().end(); ++y)
+                        for (uint32_t x = range.cols().begin(); x < range.cols().end(); ++x) runLaunch(ts, ds, uvec3(x, y, z));
+                if (options.progress) options.progress->advance(range.rows().size() * range.cols().size());
+            });
+    });
+}
+
+// The thread's statistics in DispatchStats form (raysPerType stays unsorted: merge sorts).
+DispatchStats finishedStats(const ThreadState& ts) {
+    DispatchStats st = ts.stats;
+    for (const detail::ExportCount& e : ts.exportCounts) st.invocationsPerExport.push_back({e.shader->name, e.shader->stage, e.count});
+    st.stagesProfiled = ts.profiling;
+    if (ts.profiling)
+        for (size_t i = 0; i < kProfileStageCount; ++i) st.stageSeconds[i] = std::chrono::duration<double>(ts.clock.spent[i]).count();
+    return st;
+}
+
+// Every thread's diagnostics and statistics, merged into `result`. OnError::Stop: throws the error of the
+// lowest launch index (GEN-1).
+void collectResults(ThreadStates& threadStates, const DispatchRaysDesc& desc, DispatchResult& result) {
+    std::vector<Diagnostic> errors;
+    for (auto& ts : threadStates) {
+        result.diagnostics.merge(ts.log);
+        result.stats.merge(finishedStats(ts));
+        errors.insert(errors.end(), ts.stopErrors.begin(), ts.stopErrors.end());
+    }
+    if (!errors.empty()) {
+        auto linear = [&](const Diagnostic& d) { return linearIndex(desc, d.site ? d.site->launchIndex : uvec3(0u)); };
+        auto first = std::min_element(errors.begin(), errors.end(),
+                                      [&](const Diagnostic& a, const Diagnostic& b) { return linear(a) < linear(b); });
+        throw DxrError(*first);
+    }
+}
+
+}  // namespace
+
+DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObjectPtr& pipeline,
+                                    const GlobalRootArguments* globalArguments, const DispatchOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
+    const uint64_t launches = uint64_t(desc.Width) * desc.Height * desc.Depth;
+    checkDispatchDesc(desc, pipeline, launches, memory_);
+    const LaunchRegion region = launchRegion(desc, options);
+    checkGlobalArguments(globalArguments);
+
+    DispatchState ds;
     ds.device = this;
     ds.memory = &memory_;
     ds.pipeline = pipeline.get();
@@ -117,101 +223,22 @@ DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObj
     ds.epoch = epoch_.load();
     for (const ProgramEntry& entry : pipeline->entries())
         if (entry.anyHit) ds.anyHitInPipeline = true;
+    resolveRayGenerationRecord(ds);
 
-    // The ray generation record (IDX-9, IDX-13), resolved once for every thread.
-    {
-        detail::ThreadState probe;
-        probe.dispatch = &ds;
-        static const std::string none;
-        const detail::Site site{ShaderStage::RayGeneration, &none, 0};
-        DispatchOptions stop = options;
-        stop.onError = OnError::Stop;
-        ds.options = stop;
-        const GpuVirtualAddressRangeAndStride rg{desc.RayGenerationShaderRecord.StartAddress,
-                                                 desc.RayGenerationShaderRecord.SizeInBytes, 0};
-        if (rg.StartAddress == 0 || rg.SizeInBytes < kShaderIdentifierSizeInBytes)
-            throw DxrError(diag("IDX-9", "RayGenerationShaderRecord must hold at least the 32-byte identifier")
-                               .hex("StartAddress", rg.StartAddress)
-                               .value("SizeInBytes", rg.SizeInBytes, ">= 32"));
-        detail::lookupRecord(probe, site, ProgramEntry::Kind::RayGeneration, rg, 0, ds.rayGenRecord);
-        ds.options = options;
-    }
     DispatchResult result;
     result.stats.stagesProfiled = options.profileStages;
-    if (!ds.rayGenRecord.entry || threads == 0) {  // REC-8: NULL ray generation; RGS-1: zero size
-        result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        return result;
-    }
-
-    TableLock lock(memory_, {desc.RayGenerationShaderRecord.StartAddress, desc.MissShaderTable.StartAddress,
-                             desc.HitGroupTable.StartAddress, desc.CallableShaderTable.StartAddress});
-    tbb::enumerable_thread_specific<detail::ThreadState> threadStates([&] {
-        detail::ThreadState ts;
-        ts.dispatch = &ds;
-        ts.candidates.reserve(64);
-        ts.profiling = options.profileStages;
-        return ts;
-    });
-
-    const uint32_t tile = std::max(1u, options.tileSize);
-    const int arenaThreads = options.threads ? int(options.threads) : tbb::task_arena::automatic;
-    tbb::task_arena arena(arenaThreads);
-    arena.execute([&] {
-        tbb::parallel_for(
-            tbb::blocked_range2d<uint32_t>(region.y, region.y + region.height, tile, region.x, region.x + region.width, tile),
-            [&](const tbb::blocked_range2d<uint32_t>& range) {
-                detail::ThreadState& ts = threadStates.local();
-                for (uint32_t z = 0; z < desc.Depth; ++z) {
-                    for (uint32_t y = range.rows().begin(); y < range.rows().end(); ++y) {
-                        for (uint32_t x = range.cols().begin(); x < range.cols().end(); ++x) {
-                            ts.launchIndex = uvec3(x, y, z);
-                            ts.linearIndex = (uint64_t(z) * desc.Height + y) * desc.Width + x;
-                            if (ts.linearIndex > ds.firstErrorIndex.load(std::memory_order_relaxed)) continue;
-                            ts.rayCounter = 0;
-                            detail::Invocation inv;
-                            inv.stage = ShaderStage::RayGeneration;
-                            inv.shader = ds.rayGenRecord.entry->shader;
-                            inv.record = &ds.rayGenRecord;
-                            inv.dispatch = &ds;
-                            inv.thread = &ts;
-                            inv.depth = 0;
-                            try {
-                                detail::checkGlobalSignature(ts, detail::siteOf(inv), *ds.rayGenRecord.entry);
-                                detail::invoke(ts, inv, nullptr, nullptr);
-                            } catch (const DxrError& e) {
-                                ts.stopErrors.push_back(e.diagnostic());
-                                uint64_t seen = ds.firstErrorIndex.load();
-                                while (ts.linearIndex < seen && !ds.firstErrorIndex.compare_exchange_weak(seen, ts.linearIndex)) {
-                                }
-                            } catch (const Error& e) {
-                                Diagnostic d = diag("GEN-1", e.what());
-                                d.site = DiagnosticSite{ts.launchIndex, 0, ShaderStage::RayGeneration, inv.shader->name};
-                                ts.stopErrors.push_back(d);
-                                uint64_t seen = ds.firstErrorIndex.load();
-                                while (ts.linearIndex < seen && !ds.firstErrorIndex.compare_exchange_weak(seen, ts.linearIndex)) {
-                                }
-                            }
-                        }
-                    }
-                }
-                if (options.progress) options.progress->advance(range.rows().size() * range.cols().size());
-            });
-    });
-
-    std::vector<Diagnostic> errors;
-    for (auto& ts : threadStates) {
-        result.diagnostics.merge(ts.log);
-        result.stats.merge(detail::finishedStats(ts));
-        errors.insert(errors.end(), ts.stopErrors.begin(), ts.stopErrors.end());
-    }
-    if (!errors.empty()) {
-        auto linear = [&](const Diagnostic& d) {
-            const uvec3 l = d.site ? d.site->launchIndex : uvec3(0u);
-            return (uint64_t(l.z) * desc.Height + l.y) * desc.Width + l.x;
-        };
-        auto first = std::min_element(errors.begin(), errors.end(),
-                                      [&](const Diagnostic& a, const Diagnostic& b) { return linear(a) < linear(b); });
-        throw DxrError(*first);
+    if (ds.rayGenRecord.entry && launches != 0) {  // else REC-8: NULL ray generation; RGS-1: zero size
+        const TableLock lock(memory_, {desc.RayGenerationShaderRecord.StartAddress, desc.MissShaderTable.StartAddress,
+                                       desc.HitGroupTable.StartAddress, desc.CallableShaderTable.StartAddress});
+        ThreadStates threadStates([&] {
+            ThreadState ts;
+            ts.dispatch = &ds;
+            ts.candidates.reserve(64);
+            ts.profiling = options.profileStages;
+            return ts;
+        });
+        runTiles(ds, region, threadStates);
+        collectResults(threadStates, desc, result);
     }
     result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
