@@ -121,19 +121,16 @@ bool validateFlags(ThreadState& ts, const Site& site, uint32_t rayFlags, uint32_
     return true;
 }
 
-}  // namespace
-
-void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags, uint32_t mask, uint32_t r,
-              uint32_t m, uint32_t missIndex, const RayDesc& ray, void* payload, TypeTag payloadType) {
-    ThreadState& ts = *caller.thread;
-    DispatchState& ds = *ts.dispatch;
-    const Site site = siteOf(caller);
-
-    if (caller.depth >= ds.pipeline->maxTraceRecursionDepth()) {  // LIM-2
+// LIM-2, RAY-10 (undefined bits are dropped from `rayFlags`), FLAG-2..5, RAY-5 and RAY-7, IDX-2. Returns false
+// when an error's fallback is that the call does nothing.
+bool checkArguments(ThreadState& ts, const Site& site, uint32_t depth, uint32_t& rayFlags, uint32_t r, uint32_t m,
+                    const RayDesc& ray) {
+    const StateObject& pipeline = *ts.dispatch->pipeline;
+    if (depth >= pipeline.maxTraceRecursionDepth()) {  // LIM-2
         raise(ts, site, diag("LIM-2", "TraceRay at the recursion limit: a call at depth == MaxTraceRecursionDepth removes the device")
-                            .value("depth", caller.depth, "< MaxTraceRecursionDepth " + std::to_string(ds.pipeline->maxTraceRecursionDepth()))
+                            .value("depth", depth, "< MaxTraceRecursionDepth " + std::to_string(pipeline.maxTraceRecursionDepth()))
                             .value("call chain", describeCallChain(ts)));
-        return;  // fallback: the call does nothing
+        return false;  // fallback: the call does nothing
     }
     if (rayFlags & ~kDefinedRayFlags) {  // RAY-10
         raise(ts, site, diag("RAY-10", "TraceRay flags set undefined bits")
@@ -141,19 +138,154 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
                             .hex("undefined bits", rayFlags & ~kDefinedRayFlags));
         rayFlags &= kDefinedRayFlags;
     }
-    if (!validateFlags(ts, site, rayFlags, ds.pipeline->pipelineFlags())) return;
+    if (!validateFlags(ts, site, rayFlags, pipeline.pipelineFlags())) return false;
     bool rayOk = true;
     validateRay(ts, site, ray, rayOk);
-    if (!rayOk) return;
+    if (!rayOk) return false;
     if ((r & ~kRayContributionMask) || (m & ~kGeometryMultiplierMask))  // IDX-2
         warn(ts, site, warning("IDX-2", "TraceRay index arguments have bits above the low 4; DXR ignores them")
                            .value("RayContributionToHitGroupIndex", r, "0..15")
                            .value("MultiplierForGeometryContributionToHitGroupIndex", m, "0..15"));
+    return true;
+}
+
+// The TraceRay and TraceRayEnd events. `asAddress` and `mask` are the TraceRay arguments as passed.
+void emitRay(const ThreadState& ts, const RayState& rs, TraceEvent::Kind kind, GpuVirtualAddress asAddress,
+             uint32_t mask) {
+    TraceEvent e = event(ts, kind, rs.depth);
+    e.accelerationStructure = asAddress;
+    e.ray = rs.ray;
+    e.rayFlags = rs.rayFlags;
+    e.effectiveFlags = rs.effectiveFlags;
+    e.instanceInclusionMask = mask;
+    e.rayContribution = rs.rayContribution;
+    e.multiplier = rs.multiplier;
+    e.missShaderIndex = rs.missShaderIndex;
+    e.committed = rs.committed;
+    if (rs.committed) {
+        const HitInfo& h = rs.committedHit;
+        setHit(e, *h.instance, h.instanceIndex, h.geometryIndex, h.primitiveIndex);
+        e.t = h.t;
+        e.hitKind = h.hitKind;
+    }
+    if (kind == TraceEvent::Kind::TraceRayEnd && rs.committed && (rs.effectiveFlags & RAY_FLAG_SKIP_CLOSEST_HIT_SHADER))
+        e.note = "closest hit skipped: SKIP_CLOSEST_HIT_SHADER (FLAG-9)";
+    e.payloadTypeId = rs.payloadType.id;
+    e.payloadTypeName = rs.payloadType.mangledName;
+    e.payload = static_cast<const uint8_t*>(rs.payload);
+    e.payloadSize = rs.payloadType.size;
+    observer(ts)->onEvent(e);
+}
+
+// The TLAS at `asAddress` (a one-entry cache per thread), checked for INST-8 once per acceleration-structure
+// epoch. Null when it has raised RAY-1, INST-10 or INST-8.
+const TopLevelAS* findTopLevelAS(ThreadState& ts, const Site& site, GpuVirtualAddress asAddress) {
+    const DispatchState& ds = *ts.dispatch;
+    if (asAddress != ts.lastTlasAddress) {
+        ts.lastTlas = ds.device->findTopLevelAS(asAddress);
+        ts.lastTlasAddress = ts.lastTlas ? asAddress : 0;
+    }
+    const TopLevelAS* tlas = ts.lastTlas;
+    if (!tlas) {
+        const bool isBottom = ds.device->findBottomLevelAS(asAddress) != nullptr;
+        raise(ts, site, diag(isBottom ? "INST-10" : "RAY-1",
+                             isBottom ? "TraceRay was given a BLAS; it needs a TLAS"
+                                      : "TraceRay was given an address that is not an acceleration structure")
+                            .hex("AccelerationStructure", asAddress));
+        return nullptr;
+    }
+    if (tlas->checkedEpoch() != ds.epoch) {  // INST-8
+        for (size_t i = 0; i < tlas->instances().size(); ++i) {
+            const BuiltInstance& inst = tlas->instances()[i];
+            if (inst.blas && inst.blas->generation() != inst.blasGeneration) {
+                raise(ts, site, diag("INST-8", "the TLAS was not rebuilt or updated after a BLAS it references was updated")
+                                    .value("InstanceIndex", i)
+                                    .hex("BLAS", inst.blas->address()));
+                return nullptr;
+            }
+        }
+        tlas->markChecked(ds.epoch);
+    }
+    return tlas;
+}
+
+// TRV-4: the ray's candidates in order (gathered by gatherOrderedCandidates), each meeting the DXR rules, until
+// the search ends.
+void processCandidates(ThreadState& ts, RayState& rs, const Site& site) {
+    // Nested TraceRays (from the CHS that follows) reuse ts.candidates: iterate over a copy only
+    // while shaders of this ray may run, which ends before the CHS starts.
+    for (size_t i = 0; i < ts.candidates.size() && !rs.searchEnded; ++i) {
+        const Candidate c = ts.candidates[i];
+        if (observer(ts)) {
+            TraceEvent e = event(ts, TraceEvent::Kind::Candidate, rs.depth);
+            setHit(e, rs.tlas->instances()[c.instanceIndex], c.instanceIndex, c.geometryIndex, c.primitiveIndex);
+            e.procedural = c.procedural;
+            e.t = c.procedural ? c.key : c.t;
+            observer(ts)->onEvent(e);
+        }
+        processCandidate(ts, rs, c, site);
+    }
+}
+
+// TRV-5, TRV-6: at most one CHS or one miss shader.
+void runClosestHitOrMiss(ThreadState& ts, RayState& rs, const Site& site) {
+    const DispatchState& ds = *ts.dispatch;
+    if (rs.committed) {
+        if (!(rs.effectiveFlags & RAY_FLAG_SKIP_CLOSEST_HIT_SHADER)) {  // FLAG-9
+            const HitInfo& hit = rs.committedHit;
+            const HitGroupIndexTerms terms = hitGroupRecordIndex(rs.rayContribution, rs.multiplier, hit.geometryIndex,
+                                                                 hit.instance->desc.InstanceContributionToHitGroupIndex);
+            const BuiltGeometry& geom = hit.instance->blas->geometries()[hit.geometryIndex];
+            HitLookupContext lookup{&terms, &hit, geom.type};
+            RecordView record;
+            if (lookupRecord(ts, site, ProgramEntry::Kind::HitGroup, ds.desc->HitGroupTable, terms.index, record, &lookup) &&
+                record.entry && record.entry->closestHit) {
+                Invocation inv;
+                inv.stage = ShaderStage::ClosestHit;
+                inv.shader = record.entry->closestHit;
+                inv.record = &record;
+                inv.ray = &rs;
+                inv.hit = &rs.committedHit;
+                inv.dispatch = ts.dispatch;
+                inv.thread = &ts;
+                inv.depth = rs.depth;
+                checkGlobalSignature(ts, siteOf(inv), *record.entry);
+                checkPayload(ts, siteOf(inv), *inv.shader, rs.payloadType);
+                invoke(ts, inv, rs.payload, rs.committedHit.attributes);
+            }
+        }
+    } else {
+        RecordView record;
+        if (lookupRecord(ts, site, ProgramEntry::Kind::Miss, ds.desc->MissShaderTable, missRecordIndex(rs.missShaderIndex),
+                         record) &&
+            record.entry) {
+            Invocation inv;
+            inv.stage = ShaderStage::Miss;
+            inv.shader = record.entry->shader;
+            inv.record = &record;
+            inv.ray = &rs;
+            inv.dispatch = ts.dispatch;
+            inv.thread = &ts;
+            inv.depth = rs.depth;
+            checkGlobalSignature(ts, siteOf(inv), *record.entry);
+            checkPayload(ts, siteOf(inv), *inv.shader, rs.payloadType);
+            invoke(ts, inv, rs.payload, nullptr);
+        }
+    }
+}
+
+}  // namespace
+
+void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags, uint32_t mask, uint32_t r,
+              uint32_t m, uint32_t missIndex, const RayDesc& ray, void* payload, TypeTag payloadType) {
+    ThreadState& ts = *caller.thread;
+    const Site site = siteOf(caller);
+    if (!checkArguments(ts, site, caller.depth, rayFlags, r, m, ray)) return;
 
     RayState rs;
     rs.ray = ray;
     rs.rayFlags = rayFlags;
-    rs.effectiveFlags = rayFlags | ds.pipeline->pipelineFlags();
+    rs.effectiveFlags = rayFlags | ts.dispatch->pipeline->pipelineFlags();
     rs.instanceInclusionMask = mask & kInstanceInclusionMaskBits;
     rs.rayContribution = r;
     rs.multiplier = m;
@@ -172,32 +304,7 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
     }
     std::memcpy(local, payload, payloadType.size);
     rs.payload = local;
-    auto emitRay = [&](TraceEvent::Kind kind) {
-        TraceEvent e = event(ts, kind, rs.depth);
-        e.accelerationStructure = asAddress;
-        e.ray = ray;
-        e.rayFlags = rayFlags;
-        e.effectiveFlags = rs.effectiveFlags;
-        e.instanceInclusionMask = mask;
-        e.rayContribution = r;
-        e.multiplier = m;
-        e.missShaderIndex = missIndex;
-        e.committed = rs.committed;
-        if (rs.committed) {
-            const HitInfo& h = rs.committedHit;
-            setHit(e, *h.instance, h.instanceIndex, h.geometryIndex, h.primitiveIndex);
-            e.t = h.t;
-            e.hitKind = h.hitKind;
-        }
-        if (kind == TraceEvent::Kind::TraceRayEnd && rs.committed && (rs.effectiveFlags & RAY_FLAG_SKIP_CLOSEST_HIT_SHADER))
-            e.note = "closest hit skipped: SKIP_CLOSEST_HIT_SHADER (FLAG-9)";
-        e.payloadTypeId = payloadType.id;
-        e.payloadTypeName = payloadType.mangledName;
-        e.payload = local;
-        e.payloadSize = payloadType.size;
-        observer(ts)->onEvent(e);
-    };
-    if (observer(ts)) emitRay(TraceEvent::Kind::TraceRay);
+    if (observer(ts)) emitRay(ts, rs, TraceEvent::Kind::TraceRay, asAddress, mask);
 
     countRay(ts, {r & kRayContributionMask, missIndex & kMissShaderIndexMask}, rs.depth);
     ts.rayCounter++;
@@ -206,92 +313,13 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
     // components beyond Embree's range get the same treatment. Embree never sees either kind of ray.
     const bool traceable = inTraversalRange(ray);  // false for NaN and infinite components too
     if (asAddress != 0 && traceable) {
-        if (asAddress != ts.lastTlasAddress) {
-            ts.lastTlas = ds.device->findTopLevelAS(asAddress);
-            ts.lastTlasAddress = ts.lastTlas ? asAddress : 0;
-        }
-        rs.tlas = ts.lastTlas;
-        if (!rs.tlas) {
-            const bool isBottom = ds.device->findBottomLevelAS(asAddress) != nullptr;
-            raise(ts, site, diag(isBottom ? "INST-10" : "RAY-1",
-                                 isBottom ? "TraceRay was given a BLAS; it needs a TLAS"
-                                          : "TraceRay was given an address that is not an acceleration structure")
-                                .hex("AccelerationStructure", asAddress));
-            return;
-        }
-        if (rs.tlas->checkedEpoch() != ds.epoch) {  // INST-8
-            for (size_t i = 0; i < rs.tlas->instances().size(); ++i) {
-                const BuiltInstance& inst = rs.tlas->instances()[i];
-                if (inst.blas && inst.blas->generation() != inst.blasGeneration) {
-                    raise(ts, site, diag("INST-8", "the TLAS was not rebuilt or updated after a BLAS it references was updated")
-                                        .value("InstanceIndex", i)
-                                        .hex("BLAS", inst.blas->address()));
-                    return;
-                }
-            }
-            rs.tlas->markChecked(ds.epoch);
-        }
-
-        // Gather (Embree broad phase + exact tests), order (GEN-3), then TRV-4 per candidate.
+        rs.tlas = findTopLevelAS(ts, site, asAddress);
+        if (!rs.tlas) return;
         gatherOrderedCandidates(ts, rs, site);
-        // Nested TraceRays (from the CHS below) reuse ts.candidates: iterate over a copy only
-        // while shaders of this ray may run, which ends before the CHS starts.
-        for (size_t i = 0; i < ts.candidates.size() && !rs.searchEnded; ++i) {
-            const Candidate c = ts.candidates[i];
-            if (observer(ts)) {
-                TraceEvent e = event(ts, TraceEvent::Kind::Candidate, rs.depth);
-                setHit(e, rs.tlas->instances()[c.instanceIndex], c.instanceIndex, c.geometryIndex, c.primitiveIndex);
-                e.procedural = c.procedural;
-                e.t = c.procedural ? c.key : c.t;
-                observer(ts)->onEvent(e);
-            }
-            processCandidate(ts, rs, c, site);
-        }
+        processCandidates(ts, rs, site);
     }
-
-    // TRV-5, TRV-6: at most one CHS or one miss shader.
-    if (rs.committed) {
-        if (!(rs.effectiveFlags & RAY_FLAG_SKIP_CLOSEST_HIT_SHADER)) {  // FLAG-9
-            const HitInfo& hit = rs.committedHit;
-            const HitGroupIndexTerms terms =
-                hitGroupRecordIndex(r, m, hit.geometryIndex, hit.instance->desc.InstanceContributionToHitGroupIndex);
-            const BuiltGeometry& geom = hit.instance->blas->geometries()[hit.geometryIndex];
-            HitLookupContext lookup{&terms, &hit, geom.type};
-            RecordView record;
-            if (lookupRecord(ts, site, ProgramEntry::Kind::HitGroup, ds.desc->HitGroupTable, terms.index, record, &lookup) &&
-                record.entry && record.entry->closestHit) {
-                Invocation inv;
-                inv.stage = ShaderStage::ClosestHit;
-                inv.shader = record.entry->closestHit;
-                inv.record = &record;
-                inv.ray = &rs;
-                inv.hit = &rs.committedHit;
-                inv.dispatch = &ds;
-                inv.thread = &ts;
-                inv.depth = rs.depth;
-                checkGlobalSignature(ts, siteOf(inv), *record.entry);
-                checkPayload(ts, siteOf(inv), *inv.shader, payloadType);
-                invoke(ts, inv, rs.payload, rs.committedHit.attributes);
-            }
-        }
-    } else {
-        RecordView record;
-        if (lookupRecord(ts, site, ProgramEntry::Kind::Miss, ds.desc->MissShaderTable, missRecordIndex(missIndex), record) &&
-            record.entry) {
-            Invocation inv;
-            inv.stage = ShaderStage::Miss;
-            inv.shader = record.entry->shader;
-            inv.record = &record;
-            inv.ray = &rs;
-            inv.dispatch = &ds;
-            inv.thread = &ts;
-            inv.depth = rs.depth;
-            checkGlobalSignature(ts, siteOf(inv), *record.entry);
-            checkPayload(ts, siteOf(inv), *inv.shader, payloadType);
-            invoke(ts, inv, rs.payload, nullptr);
-        }
-    }
-    if (observer(ts)) emitRay(TraceEvent::Kind::TraceRayEnd);
+    runClosestHitOrMiss(ts, rs, site);
+    if (observer(ts)) emitRay(ts, rs, TraceEvent::Kind::TraceRayEnd, asAddress, mask);
     std::memcpy(payload, local, payloadType.size);
 }
 
