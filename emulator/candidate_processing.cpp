@@ -19,7 +19,7 @@ namespace {
 void commit(const ThreadState& ts, RayState& rs, const HitInfo& hit) {  // TRV-4 step 4
     if (observer(ts)) {
         TraceEvent e = event(ts, TraceEvent::Kind::Commit, rs.depth);
-        setHit(e, *hit.instance, hit.instanceIndex, hit.geometryIndex, hit.primitiveIndex);
+        setHit(e, hit);
         e.t = hit.t;
         e.hitKind = hit.hitKind;
         observer(ts)->onEvent(e);
@@ -32,15 +32,7 @@ void commit(const ThreadState& ts, RayState& rs, const HitInfo& hit) {  // TRV-4
 enum class AnyHitOutcome { Accept, Ignore, AcceptAndEnd };
 
 AnyHitOutcome runAnyHit(ThreadState& ts, RayState& rs, const RecordView& record, HitInfo& candidate) {
-    Invocation inv;
-    inv.stage = ShaderStage::AnyHit;
-    inv.shader = record.entry->anyHit;
-    inv.record = &record;
-    inv.ray = &rs;
-    inv.hit = &candidate;
-    inv.dispatch = ts.dispatch;
-    inv.thread = &ts;
-    inv.depth = rs.depth;
+    Invocation inv = invocation(ts, ShaderStage::AnyHit, record.entry->anyHit, &record, rs.depth, &rs, &candidate);
     checkGlobalSignature(ts, siteOf(inv), *record.entry);
     checkPayload(ts, siteOf(inv), *inv.shader, rs.payloadType);
     AnyHitOutcome outcome = AnyHitOutcome::Accept;
@@ -53,7 +45,7 @@ AnyHitOutcome runAnyHit(ThreadState& ts, RayState& rs, const RecordView& record,
     }
     if (observer(ts)) {
         TraceEvent e = event(ts, TraceEvent::Kind::AnyHit, rs.depth);
-        setHit(e, *candidate.instance, candidate.instanceIndex, candidate.geometryIndex, candidate.primitiveIndex);
+        setHit(e, candidate);
         e.t = candidate.t;
         e.note = outcome == AnyHitOutcome::Ignore         ? "IgnoreHit: the candidate is dropped"
                  : outcome == AnyHitOutcome::AcceptAndEnd ? "AcceptHitAndEndSearch: commit and end the search"
@@ -72,7 +64,7 @@ bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attrib
     const ProgramEntry& group = *inv.record->entry;
     if (observer(ts)) {
         TraceEvent e = event(ts, TraceEvent::Kind::ReportHit, rs.depth);
-        setHit(e, *inv.hit->instance, inv.hit->instanceIndex, inv.hit->geometryIndex, inv.hit->primitiveIndex);
+        setHit(e, *inv.hit);
         e.t = tHit;
         e.hitKind = hitKind;
         e.accepted = !std::isnan(tHit) && type == group.attributes && tHit >= rs.ray.TMin && tHit <= rs.tCurrent;
@@ -123,8 +115,6 @@ bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attrib
     return true;
 }
 
-namespace {
-
 void processTriangle(ThreadState& ts, RayState& rs, const Candidate& c, const Site& site) {
     if (!(rs.ray.TMin < c.t && c.t < rs.tCurrent)) {  // TRV-2: open interval, current TCurrent
         if (observer(ts)) emitSkipped(ts, rs, "t outside (RayTMin, RayTCurrent) (TRV-2)");
@@ -162,13 +152,9 @@ void processTriangle(ThreadState& ts, RayState& rs, const Candidate& c, const Si
 
     bool endSearch = false;
     if (!opaque) {  // OPQ-3: the record is needed only to find an AHS (IDX-12)
-        const HitGroupIndexTerms terms = hitGroupRecordIndex(rs.rayContribution, rs.multiplier, c.geometryIndex,
-                                                             inst.desc.InstanceContributionToHitGroupIndex);
-        HitLookupContext lookup{&terms, &hit, GeometryType::Triangles};
         RecordView record;
-        if (lookupRecord(ts, site, ProgramEntry::Kind::HitGroup, ts.dispatch->desc->HitGroupTable, terms.index, record,
-                         &lookup) &&
-            record.entry && record.entry->anyHit) {
+        if (lookupHitGroupRecord(ts, site, rs, hit, GeometryType::Triangles, record) && record.entry &&
+            record.entry->anyHit) {
             switch (runAnyHit(ts, rs, record, hit)) {
                 case AnyHitOutcome::Ignore: return;
                 case AnyHitOutcome::AcceptAndEnd: endSearch = true; break;
@@ -201,27 +187,14 @@ void processProcedural(ThreadState& ts, RayState& rs, const Candidate& c, const 
     box.objectRayOrigin = c.objectRayOrigin;
     box.objectRayDirection = c.objectRayDirection;
 
-    const HitGroupIndexTerms terms = hitGroupRecordIndex(rs.rayContribution, rs.multiplier, c.geometryIndex,
-                                                         inst.desc.InstanceContributionToHitGroupIndex);
-    HitLookupContext lookup{&terms, &box, GeometryType::ProceduralPrimitiveAABBs};
     RecordView record;
-    if (!lookupRecord(ts, site, ProgramEntry::Kind::HitGroup, ts.dispatch->desc->HitGroupTable, terms.index, record,
-                      &lookup))
-        return;
+    if (!lookupHitGroupRecord(ts, site, rs, box, GeometryType::ProceduralPrimitiveAABBs, record)) return;
     if (!record.entry) {  // OPQ-4: a NULL hit group has no IS, so no hit
         if (observer(ts)) emitSkipped(ts, rs, "NULL hit group: no intersection shader, no hit (OPQ-4)");
         return;
     }
 
-    Invocation inv;
-    inv.stage = ShaderStage::Intersection;
-    inv.shader = record.entry->intersection;
-    inv.record = &record;
-    inv.ray = &rs;
-    inv.hit = &box;
-    inv.dispatch = ts.dispatch;
-    inv.thread = &ts;
-    inv.depth = rs.depth;
+    Invocation inv = invocation(ts, ShaderStage::Intersection, record.entry->intersection, &record, rs.depth, &rs, &box);
     inv.candidateOpaque = opaque;
     checkGlobalSignature(ts, siteOf(inv), *record.entry);
     try {
@@ -232,11 +205,5 @@ void processProcedural(ThreadState& ts, RayState& rs, const Candidate& c, const 
     }
 }
 
-}  // namespace
-
-void processCandidate(ThreadState& ts, RayState& rs, const Candidate& c, const Site& site) {
-    if (c.procedural) processProcedural(ts, rs, c, site);
-    else processTriangle(ts, rs, c, site);
-}
 
 }  // namespace refray::dxr::detail

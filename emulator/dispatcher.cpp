@@ -139,13 +139,8 @@ void runLaunch(ThreadState& ts, DispatchState& ds, uvec3 launch) {
     ts.linearIndex = linearIndex(*ds.desc, launch);
     if (ts.linearIndex > ds.firstErrorIndex.load(std::memory_order_relaxed)) return;
     ts.rayCounter = 0;
-    detail::Invocation inv;
-    inv.stage = ShaderStage::RayGeneration;
-    inv.shader = ds.rayGenRecord.entry->shader;
-    inv.record = &ds.rayGenRecord;
-    inv.dispatch = &ds;
-    inv.thread = &ts;
-    inv.depth = 0;
+    detail::Invocation inv =
+        detail::invocation(ts, ShaderStage::RayGeneration, ds.rayGenRecord.entry->shader, &ds.rayGenRecord, 0);
     try {
         detail::checkGlobalSignature(ts, detail::siteOf(inv), *ds.rayGenRecord.entry);
         detail::invoke(ts, inv, nullptr, nullptr);

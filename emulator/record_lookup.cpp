@@ -59,8 +59,8 @@ bool lookupRecordChecked(ThreadState& ts, const Site& site, ProgramEntry::Kind k
     const std::string_view name = tableName(kind);
     out = RecordView{};
     out.index = index;
-    const uint64_t offset = table.StrideInBytes * index;
-    out.address = table.StartAddress + offset;
+    out.address = recordAddress(table, index);
+    const uint64_t offset = out.address - table.StartAddress;
 
     if (table.StartAddress == 0 && table.SizeInBytes == 0) {
         auto b = diag("IDX-11", "the " + std::string(name) + " is missing (StartAddress 0, SizeInBytes 0) but a record is needed");
@@ -166,13 +166,13 @@ bool lookupRecord(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
                          site.depth + (kind == ProgramEntry::Kind::HitGroup || kind == ProgramEntry::Kind::Miss ? 1 : 0));
     e.table = tableName(kind);
     e.recordIndex = index;
-    e.recordAddress = table.StartAddress + table.StrideInBytes * index;
+    e.recordAddress = recordAddress(table, index);
     e.stride = table.StrideInBytes;
     if (hit && hit->terms) {
         e.hasTerms = true;
         e.terms = *hit->terms;
     }
-    if (hit && hit->hit) setHit(e, *hit->hit->instance, hit->hit->instanceIndex, hit->hit->geometryIndex, hit->hit->primitiveIndex);
+    if (hit && hit->hit) setHit(e, *hit->hit);
     bool ok = false;
     try {
         ok = lookupRecordChecked(ts, site, kind, table, index, out, hit);

@@ -2,9 +2,6 @@
 // trace event, call chain and stage time, and CallShader.
 #include "emulator/detail/shader_invocation.h"
 
-#include <cstring>
-#include <memory>
-
 #include "emulator/detail/record_lookup.h"
 #include "emulator/detail/thread_state.h"
 #include "emulator/detail/trace_events.h"
@@ -54,7 +51,7 @@ void invoke(ThreadState& ts, Invocation& inv, void* payload, const void* attribu
             e.recordIndex = inv.record->index;
             e.recordAddress = inv.record->address;
         }
-        if (inv.hit) setHit(e, *inv.hit->instance, inv.hit->instanceIndex, inv.hit->geometryIndex, inv.hit->primitiveIndex);
+        if (inv.hit) setHit(e, *inv.hit);
         observer(ts)->onEvent(e);
     }
     ShaderContext ctx(inv);
@@ -89,24 +86,12 @@ void callShader(Invocation& caller, uint32_t shaderIndex, void* parameters, Type
                             .value("declared", shader.parameters.name() + " (" + std::to_string(shader.parameters.size) + " B)"));
         return;
     }
-    Invocation inv;
-    inv.stage = ShaderStage::Callable;
-    inv.shader = &shader;
-    inv.record = &record;
-    inv.dispatch = &ds;
-    inv.thread = &ts;
-    inv.depth = caller.depth;  // CALL-3: callables do not count toward recursion
+    // CALL-3: callables do not count toward recursion.
+    Invocation inv = invocation(ts, ShaderStage::Callable, &shader, &record, caller.depth);
     checkGlobalSignature(ts, siteOf(inv), *record.entry);
-    alignas(16) uint8_t local[256];
-    std::unique_ptr<uint8_t[]> heap;
-    uint8_t* copy = local;
-    if (type.size > sizeof local) {
-        heap.reset(new uint8_t[type.size]);
-        copy = heap.get();
-    }
-    std::memcpy(copy, parameters, type.size);
-    invoke(ts, inv, copy, nullptr);
-    std::memcpy(parameters, copy, type.size);
+    ValueCopy copy(parameters, type.size);
+    invoke(ts, inv, copy.data(), nullptr);
+    copy.copyBack(parameters);
 }
 
 }  // namespace refray::dxr::detail

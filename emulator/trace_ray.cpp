@@ -3,8 +3,6 @@
 #include "emulator/detail/trace_ray.h"
 
 #include <cmath>
-#include <cstring>
-#include <memory>
 
 #include "emulator/detail/candidate_gathering.h"
 #include "emulator/detail/candidate_processing.h"
@@ -121,34 +119,6 @@ bool validateFlags(ThreadState& ts, const Site& site, uint32_t rayFlags, uint32_
     return true;
 }
 
-// LIM-2, RAY-10 (undefined bits are dropped from `rayFlags`), FLAG-2..5, RAY-5 and RAY-7, IDX-2. Returns false
-// when an error's fallback is that the call does nothing.
-bool checkArguments(ThreadState& ts, const Site& site, uint32_t depth, uint32_t& rayFlags, uint32_t r, uint32_t m,
-                    const RayDesc& ray) {
-    const StateObject& pipeline = *ts.dispatch->pipeline;
-    if (depth >= pipeline.maxTraceRecursionDepth()) {  // LIM-2
-        raise(ts, site, diag("LIM-2", "TraceRay at the recursion limit: a call at depth == MaxTraceRecursionDepth removes the device")
-                            .value("depth", depth, "< MaxTraceRecursionDepth " + std::to_string(pipeline.maxTraceRecursionDepth()))
-                            .value("call chain", describeCallChain(ts)));
-        return false;  // fallback: the call does nothing
-    }
-    if (rayFlags & ~kDefinedRayFlags) {  // RAY-10
-        raise(ts, site, diag("RAY-10", "TraceRay flags set undefined bits")
-                            .hex("RayFlags", rayFlags)
-                            .hex("undefined bits", rayFlags & ~kDefinedRayFlags));
-        rayFlags &= kDefinedRayFlags;
-    }
-    if (!validateFlags(ts, site, rayFlags, pipeline.pipelineFlags())) return false;
-    bool rayOk = true;
-    validateRay(ts, site, ray, rayOk);
-    if (!rayOk) return false;
-    if ((r & ~kRayContributionMask) || (m & ~kGeometryMultiplierMask))  // IDX-2
-        warn(ts, site, warning("IDX-2", "TraceRay index arguments have bits above the low 4; DXR ignores them")
-                           .value("RayContributionToHitGroupIndex", r, "0..15")
-                           .value("MultiplierForGeometryContributionToHitGroupIndex", m, "0..15"));
-    return true;
-}
-
 // The TraceRay and TraceRayEnd events. `asAddress` and `mask` are the TraceRay arguments as passed.
 void emitRay(const ThreadState& ts, const RayState& rs, TraceEvent::Kind kind, GpuVirtualAddress asAddress,
              uint32_t mask) {
@@ -163,10 +133,9 @@ void emitRay(const ThreadState& ts, const RayState& rs, TraceEvent::Kind kind, G
     e.missShaderIndex = rs.missShaderIndex;
     e.committed = rs.committed;
     if (rs.committed) {
-        const HitInfo& h = rs.committedHit;
-        setHit(e, *h.instance, h.instanceIndex, h.geometryIndex, h.primitiveIndex);
-        e.t = h.t;
-        e.hitKind = h.hitKind;
+        setHit(e, rs.committedHit);
+        e.t = rs.committedHit.t;
+        e.hitKind = rs.committedHit.hitKind;
     }
     if (kind == TraceEvent::Kind::TraceRayEnd && rs.committed && (rs.effectiveFlags & RAY_FLAG_SKIP_CLOSEST_HIT_SHADER))
         e.note = "closest hit skipped: SKIP_CLOSEST_HIT_SHADER (FLAG-9)";
@@ -177,36 +146,38 @@ void emitRay(const ThreadState& ts, const RayState& rs, TraceEvent::Kind kind, G
     observer(ts)->onEvent(e);
 }
 
-// The TLAS at `asAddress` (a one-entry cache per thread), checked for INST-8 once per acceleration-structure
-// epoch. Null when it has raised RAY-1, INST-10 or INST-8.
-const TopLevelAS* findTopLevelAS(ThreadState& ts, const Site& site, GpuVirtualAddress asAddress) {
-    const DispatchState& ds = *ts.dispatch;
+// The TLAS at `asAddress`, or null: a one-entry cache per thread in front of the device's lookup.
+const TopLevelAS* lookupTopLevelAS(ThreadState& ts, GpuVirtualAddress asAddress) {
     if (asAddress != ts.lastTlasAddress) {
-        ts.lastTlas = ds.device->findTopLevelAS(asAddress);
+        ts.lastTlas = ts.dispatch->device->findTopLevelAS(asAddress);
         ts.lastTlasAddress = ts.lastTlas ? asAddress : 0;
     }
-    const TopLevelAS* tlas = ts.lastTlas;
-    if (!tlas) {
-        const bool isBottom = ds.device->findBottomLevelAS(asAddress) != nullptr;
-        raise(ts, site, diag(isBottom ? "INST-10" : "RAY-1",
-                             isBottom ? "TraceRay was given a BLAS; it needs a TLAS"
-                                      : "TraceRay was given an address that is not an acceleration structure")
-                            .hex("AccelerationStructure", asAddress));
-        return nullptr;
-    }
-    if (tlas->checkedEpoch() != ds.epoch) {  // INST-8
-        for (size_t i = 0; i < tlas->instances().size(); ++i) {
-            const BuiltInstance& inst = tlas->instances()[i];
-            if (inst.blas && inst.blas->generation() != inst.blasGeneration) {
-                raise(ts, site, diag("INST-8", "the TLAS was not rebuilt or updated after a BLAS it references was updated")
-                                    .value("InstanceIndex", i)
-                                    .hex("BLAS", inst.blas->address()));
-                return nullptr;
-            }
+    return ts.lastTlas;
+}
+
+// RAY-1, INST-10: TraceRay was given an address that holds no TLAS.
+void raiseNotTopLevelAS(ThreadState& ts, const Site& site, GpuVirtualAddress asAddress) {
+    const bool isBottom = ts.dispatch->device->findBottomLevelAS(asAddress) != nullptr;
+    raise(ts, site, diag(isBottom ? "INST-10" : "RAY-1",
+                         isBottom ? "TraceRay was given a BLAS; it needs a TLAS"
+                                  : "TraceRay was given an address that is not an acceleration structure")
+                        .hex("AccelerationStructure", asAddress));
+}
+
+// INST-8, once per acceleration-structure epoch: no BLAS that `tlas` references was updated after the TLAS was
+// built. False when it has raised INST-8.
+bool checkBottomLevelsCurrent(ThreadState& ts, const Site& site, const TopLevelAS& tlas) {
+    for (size_t i = 0; i < tlas.instances().size(); ++i) {
+        const BuiltInstance& inst = tlas.instances()[i];
+        if (inst.blas && inst.blas->generation() != inst.blasGeneration) {
+            raise(ts, site, diag("INST-8", "the TLAS was not rebuilt or updated after a BLAS it references was updated")
+                                .value("InstanceIndex", i)
+                                .hex("BLAS", inst.blas->address()));
+            return false;
         }
-        tlas->markChecked(ds.epoch);
     }
-    return tlas;
+    tlas.markChecked(ts.dispatch->epoch);
+    return true;
 }
 
 // TRV-4: the ray's candidates in order (gathered by gatherOrderedCandidates), each meeting the DXR rules, until
@@ -232,26 +203,15 @@ void runClosestHitOrMiss(ThreadState& ts, RayState& rs, const Site& site) {
     const DispatchState& ds = *ts.dispatch;
     if (rs.committed) {
         if (!(rs.effectiveFlags & RAY_FLAG_SKIP_CLOSEST_HIT_SHADER)) {  // FLAG-9
-            const HitInfo& hit = rs.committedHit;
-            const HitGroupIndexTerms terms = hitGroupRecordIndex(rs.rayContribution, rs.multiplier, hit.geometryIndex,
-                                                                 hit.instance->desc.InstanceContributionToHitGroupIndex);
-            const BuiltGeometry& geom = hit.instance->blas->geometries()[hit.geometryIndex];
-            HitLookupContext lookup{&terms, &hit, geom.type};
+            HitInfo& hit = rs.committedHit;
+            const GeometryType type = hit.instance->blas->geometries()[hit.geometryIndex].type;
             RecordView record;
-            if (lookupRecord(ts, site, ProgramEntry::Kind::HitGroup, ds.desc->HitGroupTable, terms.index, record, &lookup) &&
-                record.entry && record.entry->closestHit) {
-                Invocation inv;
-                inv.stage = ShaderStage::ClosestHit;
-                inv.shader = record.entry->closestHit;
-                inv.record = &record;
-                inv.ray = &rs;
-                inv.hit = &rs.committedHit;
-                inv.dispatch = ts.dispatch;
-                inv.thread = &ts;
-                inv.depth = rs.depth;
+            if (lookupHitGroupRecord(ts, site, rs, hit, type, record) && record.entry && record.entry->closestHit) {
+                Invocation inv =
+                    invocation(ts, ShaderStage::ClosestHit, record.entry->closestHit, &record, rs.depth, &rs, &hit);
                 checkGlobalSignature(ts, siteOf(inv), *record.entry);
                 checkPayload(ts, siteOf(inv), *inv.shader, rs.payloadType);
-                invoke(ts, inv, rs.payload, rs.committedHit.attributes);
+                invoke(ts, inv, rs.payload, hit.attributes);
             }
         }
     } else {
@@ -259,14 +219,7 @@ void runClosestHitOrMiss(ThreadState& ts, RayState& rs, const Site& site) {
         if (lookupRecord(ts, site, ProgramEntry::Kind::Miss, ds.desc->MissShaderTable, missRecordIndex(rs.missShaderIndex),
                          record) &&
             record.entry) {
-            Invocation inv;
-            inv.stage = ShaderStage::Miss;
-            inv.shader = record.entry->shader;
-            inv.record = &record;
-            inv.ray = &rs;
-            inv.dispatch = ts.dispatch;
-            inv.thread = &ts;
-            inv.depth = rs.depth;
+            Invocation inv = invocation(ts, ShaderStage::Miss, record.entry->shader, &record, rs.depth, &rs);
             checkGlobalSignature(ts, siteOf(inv), *record.entry);
             checkPayload(ts, siteOf(inv), *inv.shader, rs.payloadType);
             invoke(ts, inv, rs.payload, nullptr);
@@ -279,13 +232,35 @@ void runClosestHitOrMiss(ThreadState& ts, RayState& rs, const Site& site) {
 void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags, uint32_t mask, uint32_t r,
               uint32_t m, uint32_t missIndex, const RayDesc& ray, void* payload, TypeTag payloadType) {
     ThreadState& ts = *caller.thread;
+    const DispatchState& ds = *ts.dispatch;
     const Site site = siteOf(caller);
-    if (!checkArguments(ts, site, caller.depth, rayFlags, r, m, ray)) return;
+
+    // The arguments: LIM-2, RAY-10 (undefined bits are dropped), FLAG-2..5, RAY-5 and RAY-7, IDX-2.
+    if (caller.depth >= ds.pipeline->maxTraceRecursionDepth()) {  // LIM-2
+        raise(ts, site, diag("LIM-2", "TraceRay at the recursion limit: a call at depth == MaxTraceRecursionDepth removes the device")
+                            .value("depth", caller.depth, "< MaxTraceRecursionDepth " + std::to_string(ds.pipeline->maxTraceRecursionDepth()))
+                            .value("call chain", describeCallChain(ts)));
+        return;  // fallback: the call does nothing
+    }
+    if (rayFlags & ~kDefinedRayFlags) {  // RAY-10
+        raise(ts, site, diag("RAY-10", "TraceRay flags set undefined bits")
+                            .hex("RayFlags", rayFlags)
+                            .hex("undefined bits", rayFlags & ~kDefinedRayFlags));
+        rayFlags &= kDefinedRayFlags;
+    }
+    if (!validateFlags(ts, site, rayFlags, ds.pipeline->pipelineFlags())) return;
+    bool rayOk = true;
+    validateRay(ts, site, ray, rayOk);
+    if (!rayOk) return;
+    if ((r & ~kRayContributionMask) || (m & ~kGeometryMultiplierMask))  // IDX-2
+        warn(ts, site, warning("IDX-2", "TraceRay index arguments have bits above the low 4; DXR ignores them")
+                           .value("RayContributionToHitGroupIndex", r, "0..15")
+                           .value("MultiplierForGeometryContributionToHitGroupIndex", m, "0..15"));
 
     RayState rs;
     rs.ray = ray;
     rs.rayFlags = rayFlags;
-    rs.effectiveFlags = rayFlags | ts.dispatch->pipeline->pipelineFlags();
+    rs.effectiveFlags = rayFlags | ds.pipeline->pipelineFlags();
     rs.instanceInclusionMask = mask & kInstanceInclusionMaskBits;
     rs.rayContribution = r;
     rs.multiplier = m;
@@ -295,15 +270,8 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
     rs.payloadType = payloadType;
 
     // RAY-9: the payload is passed by value.
-    alignas(16) uint8_t inlinePayload[256];
-    std::unique_ptr<uint8_t[]> heapPayload;
-    uint8_t* local = inlinePayload;
-    if (payloadType.size > sizeof inlinePayload) {
-        heapPayload.reset(new uint8_t[payloadType.size]);
-        local = heapPayload.get();
-    }
-    std::memcpy(local, payload, payloadType.size);
-    rs.payload = local;
+    ValueCopy local(payload, payloadType.size);
+    rs.payload = local.data();
     if (observer(ts)) emitRay(ts, rs, TraceEvent::Kind::TraceRay, asAddress, mask);
 
     countRay(ts, {r & kRayContributionMask, missIndex & kMissShaderIndexMask}, rs.depth);
@@ -313,14 +281,18 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
     // components beyond Embree's range get the same treatment. Embree never sees either kind of ray.
     const bool traceable = inTraversalRange(ray);  // false for NaN and infinite components too
     if (asAddress != 0 && traceable) {
-        rs.tlas = findTopLevelAS(ts, site, asAddress);
-        if (!rs.tlas) return;
+        rs.tlas = lookupTopLevelAS(ts, asAddress);
+        if (!rs.tlas) {
+            raiseNotTopLevelAS(ts, site, asAddress);
+            return;
+        }
+        if (rs.tlas->checkedEpoch() != ds.epoch && !checkBottomLevelsCurrent(ts, site, *rs.tlas)) return;
         gatherOrderedCandidates(ts, rs, site);
         processCandidates(ts, rs, site);
     }
     runClosestHitOrMiss(ts, rs, site);
     if (observer(ts)) emitRay(ts, rs, TraceEvent::Kind::TraceRayEnd, asAddress, mask);
-    std::memcpy(payload, local, payloadType.size);
+    local.copyBack(payload);
 }
 
 }  // namespace refray::dxr::detail

@@ -5,7 +5,9 @@
 #include <cstdint>
 
 #include "emulator/detail/dispatch_errors.h"
+#include "emulator/detail/dispatch_state.h"
 #include "emulator/detail/invocation.h"
+#include "emulator/detail/thread_state.h"
 #include "emulator/shader_table.h"
 
 namespace refray::dxr::detail {
@@ -23,5 +25,16 @@ struct HitLookupContext {
 bool lookupRecord(ThreadState& ts, const Site& site, ProgramEntry::Kind kind,
                   const GpuVirtualAddressRangeAndStride& table, uint64_t index, RecordView& out,
                   const HitLookupContext* hit = nullptr);
+
+// The hit-group record of `hit` for the ray `rs`, whose geometry is of `type` (IDX-14): the record at
+// I = R + M*G + C of the dispatch's HitGroupTable, with I from hitGroupRecordIndex, the indexing rule.
+inline bool lookupHitGroupRecord(ThreadState& ts, const Site& site, const RayState& rs, const HitInfo& hit,
+                                 GeometryType type, RecordView& out) {
+    const HitGroupIndexTerms terms = hitGroupRecordIndex(rs.rayContribution, rs.multiplier, hit.geometryIndex,
+                                                         hit.instance->desc.InstanceContributionToHitGroupIndex);
+    const HitLookupContext lookup{&terms, &hit, type};
+    return lookupRecord(ts, site, ProgramEntry::Kind::HitGroup, ts.dispatch->desc->HitGroupTable, terms.index, out,
+                        &lookup);
+}
 
 }  // namespace refray::dxr::detail

@@ -28,6 +28,10 @@ inline void setHit(TraceEvent& e, const BuiltInstance& inst, uint32_t instanceIn
     e.primitiveIndex = primitiveIndex;
 }
 
+inline void setHit(TraceEvent& e, const HitInfo& hit) {
+    setHit(e, *hit.instance, hit.instanceIndex, hit.geometryIndex, hit.primitiveIndex);
+}
+
 inline void emitSkipped(const ThreadState& ts, const RayState& rs, std::string_view why) {
     TraceEvent e = event(ts, TraceEvent::Kind::Skipped, rs.depth);
     e.note = why;
