@@ -1,5 +1,5 @@
-// What every invocation of one DispatchRays shares. Internal to the emulator: dispatcher.cpp runs the dispatch,
-// shader_resources.cpp serves the resource intrinsics from it.
+// What every invocation of one DispatchRays shares. Internal to the emulator: dispatcher.cpp sets it up and runs
+// the launches; the TraceRay stages and the intrinsics (shader_api.cpp, shader_resources.cpp) read it.
 #pragma once
 
 #include <algorithm>
