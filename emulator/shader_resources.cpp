@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "emulator/detail/dispatch_errors.h"
 #include "emulator/detail/dispatch_state.h"
 #include "emulator/limits.h"
 #include "emulator/shader_api.h"

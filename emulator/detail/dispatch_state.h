@@ -1,12 +1,11 @@
-// What every invocation of one DispatchRays shares, and the error path of the intrinsics. Internal to the
-// emulator: dispatcher.cpp runs the dispatch, shader_resources.cpp serves the resource intrinsics from it.
+// What every invocation of one DispatchRays shares. Internal to the emulator: dispatcher.cpp sets it up and runs
+// the launches; the TraceRay stages and the intrinsics (shader_api.cpp, shader_resources.cpp) read it.
 #pragma once
 
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstdint>
-#include <string>
 
 #include "emulator/detail/invocation.h"
 #include "emulator/device.h"
@@ -90,9 +89,5 @@ struct LookupCache {
 
 // The calling worker thread's LookupCache.
 LookupCache& lookupCache(Invocation& inv);
-
-// Stops the invocation with a DxrError carrying `rule`, the stage and the launch site: misuse of the shader API
-// always stops, there is no fallback.
-[[noreturn]] void stageError(Invocation& inv, const char* rule, const std::string& message);
 
 }  // namespace refray::dxr::detail

@@ -1,0 +1,112 @@
+// Candidate gathering and order: the Embree broad phase with refray's exact tests, the traversal shortcuts it
+// may take (GatherMode), and the order in which candidates meet the DXR rules (GEN-3).
+#include "emulator/detail/candidate_gathering.h"
+
+#include <algorithm>
+#include <random>
+
+#include "emulator/detail/candidate_processing.h"
+#include "emulator/detail/candidate_rules.h"
+#include "emulator/detail/thread_state.h"
+#include "emulator/detail/trace_events.h"
+
+namespace refray::dxr::detail {
+
+namespace {
+
+// The traversal shortcuts (GatherMode; docs/emulator.md, "Traversal shortcuts").
+struct ShortcutContext {
+    ThreadState* ts;
+    RayState* rs;
+    const Site* site;
+};
+
+// Closest: an in-range triangle the ordered loop commits whenever it reaches it: not culled, and either
+// opaque or in a pipeline without any-hit shaders (then nothing can ignore it).
+bool commitsSurely(const void* user, const Candidate& c) {
+    const auto& sc = *static_cast<const ShortcutContext*>(user);
+    const BuiltInstance& inst = sc.rs->tlas->instances()[c.instanceIndex];
+    const BuiltGeometry& geom = inst.blas->geometries()[c.geometryIndex];
+    const uint32_t flags = sc.rs->effectiveFlags;
+    if (isFaceCulled(flags, inst.desc.Flags, isFrontFacing(geom, c, inst.desc.Flags))) return false;
+    const bool opaque = isOpaque(geom.flags, inst.desc.Flags, flags);
+    if (isOpacityCulled(flags, opaque)) return false;
+    return opaque || !sc.ts->dispatch->anyHitInPipeline;
+}
+
+// FirstHit: the TRV-4 step for one candidate, as Embree meets it.
+bool processNow(void* user, const Candidate& c) {
+    auto& sc = *static_cast<ShortcutContext*>(user);
+    sc.ts->stats.candidates++;
+    processCandidate(*sc.ts, *sc.rs, c, *sc.site);
+    return sc.rs->searchEnded;
+}
+
+// The shortcut a ray may take: none when it is observed, in adversarial order or with shortcuts off;
+// FirstHit when no order can change its outcome; else Closest.
+GatherMode traversalMode(const ThreadState& ts, const RayState& rs) {
+    const DispatchState& ds = *ts.dispatch;
+    if (!ds.options.specialise || observer(ts) || ds.options.order != TraversalOrder::Ordered) return GatherMode::All;
+    const uint32_t firstHit = RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_SKIP_CLOSEST_HIT_SHADER;
+    if ((rs.effectiveFlags & firstHit) == firstHit && !ds.anyHitInPipeline) return GatherMode::FirstHit;
+    return GatherMode::Closest;
+}
+
+// Orders candidates per DispatchOptions::order (GEN-3).
+void orderCandidates(ThreadState& ts, RayState& rs) {
+    auto& cs = ts.candidates;
+    std::sort(cs.begin(), cs.end(), [](const Candidate& a, const Candidate& b) {
+        if (a.key != b.key) return a.key < b.key;
+        if (a.instanceIndex != b.instanceIndex) return a.instanceIndex < b.instanceIndex;
+        if (a.geometryIndex != b.geometryIndex) return a.geometryIndex < b.geometryIndex;
+        return a.primitiveIndex < b.primitiveIndex;
+    });
+    // One candidate per primitive: Embree may report a primitive more than once (AHS-6, IS-1).
+    cs.erase(std::unique(cs.begin(), cs.end(),
+                         [](const Candidate& a, const Candidate& b) {
+                             return a.instanceIndex == b.instanceIndex && a.geometryIndex == b.geometryIndex &&
+                                    a.primitiveIndex == b.primitiveIndex;
+                         }),
+             cs.end());
+    if (ts.dispatch->options.order != TraversalOrder::Adversarial) return;
+
+    std::mt19937_64 rng(ts.dispatch->options.adversarialSeed * 0x9E3779B97F4A7C15ull ^ (ts.linearIndex << 20) ^
+                        ts.rayCounter);
+    const size_t n = cs.size();
+    for (size_t i = 0; i < n; ++i) {
+        const Candidate& c = cs[i];
+        const BuiltGeometry& g = rs.tlas->instances()[c.instanceIndex].blas->geometries()[c.geometryIndex];
+        if (!(g.flags & GEOMETRY_FLAG_NO_DUPLICATE_ANYHIT_INVOCATION) && (rng() & 1)) cs.push_back(c);
+    }
+    std::shuffle(cs.begin(), cs.end(), rng);
+}
+
+}  // namespace
+
+void gatherOrderedCandidates(ThreadState& ts, RayState& rs, const Site& site) {
+    const DispatchState& ds = *ts.dispatch;
+    ts.candidates.clear();
+    GatherRequest gather;
+    gather.tlas = rs.tlas;
+    gather.origin = rs.ray.Origin;
+    gather.direction = rs.ray.Direction;
+    gather.tMin = rs.ray.TMin;
+    gather.tMax = rs.ray.TMax;
+    gather.instanceInclusionMask = rs.instanceInclusionMask;
+    gather.skipTriangles = (rs.effectiveFlags & RAY_FLAG_SKIP_TRIANGLES) != 0;  // FLAG-12
+    gather.skipProcedural = (rs.effectiveFlags & RAY_FLAG_SKIP_PROCEDURAL_PRIMITIVES) != 0;
+    gather.alternateEdgeRule = ds.options.order == TraversalOrder::Adversarial && (ds.options.adversarialSeed & 1);
+    gather.out = &ts.candidates;
+    ShortcutContext shortcut{&ts, &rs, &site};
+    gather.user = &shortcut;
+    gather.commitsSurely = commitsSurely;
+    gather.onCandidate = processNow;
+    gather.mode = traversalMode(ts, rs);
+    ts.stats.raysPerGatherMode[size_t(gather.mode)]++;
+    gatherCandidates(gather);
+    if (gather.mode != GatherMode::FirstHit) ts.stats.candidates += ts.candidates.size();
+    else ts.candidates.clear();  // processed during the traversal
+    orderCandidates(ts, rs);
+}
+
+}  // namespace refray::dxr::detail

@@ -1,0 +1,41 @@
+// Errors and warnings raised while a dispatch runs: each is located at its launch index, depth, stage and
+// export, then thrown or recorded as DispatchOptions::onError says (GEN-1). Internal to the emulator.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "emulator/detail/invocation.h"
+#include "emulator/validation.h"
+
+namespace refray::dxr::detail {
+
+struct ThreadState;
+
+// Where a diagnostic arises: the stage, export and depth of the invocation that raises it.
+struct Site {
+    ShaderStage stage;
+    const std::string* exportName;
+    uint32_t depth;
+};
+
+inline const std::string kNoExport;
+
+inline Site siteOf(const Invocation& inv) {
+    return {inv.stage, inv.shader ? &inv.shader->name : &kNoExport, inv.depth};
+}
+
+// `d` with its site: the thread's launch index and `site`.
+Diagnostic locate(const ThreadState& ts, Diagnostic d, const Site& site);
+
+// An error at `site`. OnError::Stop: throws. Continue: records it and returns, and the
+// caller applies the fallback its rule documents.
+void raise(ThreadState& ts, const Site& site, const Diagnostic& d);
+
+void warn(ThreadState& ts, const Site& site, const Diagnostic& d);
+
+// Stops the invocation with a DxrError carrying `rule`, the stage and the launch site: misuse of the shader API
+// always stops, there is no fallback.
+[[noreturn]] void stageError(Invocation& inv, const char* rule, const std::string& message);
+
+}  // namespace refray::dxr::detail

@@ -1,0 +1,80 @@
+// What one worker thread of a DispatchRays keeps between the launches it runs: the launch being run, its
+// diagnostics and statistics, the candidate buffer and the lookup caches. Internal to the emulator.
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <vector>
+
+#include "emulator/detail/dispatch_state.h"
+#include "emulator/dispatch_stats.h"
+#include "emulator/embree_bridge.h"
+#include "emulator/validation.h"
+
+namespace refray::dxr::detail {
+
+// Exclusive stage times (DispatchOptions::profileStages): at each switch the running section is charged
+// the time since the previous switch. Sections are ProfileStage values; kOutside is time in no stage
+// (the launch loop, tile scheduling), which is not reported.
+struct StageClock {
+    using Clock = std::chrono::steady_clock;
+    static constexpr uint8_t kOutside = uint8_t(kProfileStageCount);
+    Clock::time_point mark = Clock::now();
+    uint8_t section = kOutside;
+    std::array<Clock::duration, kProfileStageCount + 1> spent{};
+
+    // Switches to `next`; returns the section to switch back to.
+    uint8_t enter(uint8_t next) {
+        const Clock::time_point now = Clock::now();
+        spent[section] += now - mark;
+        mark = now;
+        const uint8_t previous = section;
+        section = next;
+        return previous;
+    }
+};
+
+// Invocations of one export on one thread, keyed by the export (names are attached when merging).
+struct ExportCount {
+    const ShaderExport* shader = nullptr;
+    uint64_t count = 0;
+};
+
+struct ThreadState {
+    DispatchState* dispatch = nullptr;
+    uvec3 launchIndex{0u};
+    uint64_t linearIndex = 0;
+    DiagnosticLog log;
+    DispatchStats stats;
+    std::vector<Candidate> candidates;
+    uint64_t rayCounter = 0;
+    std::vector<Diagnostic> stopErrors;  // OnError::Stop: the errors that ended a launch
+    std::vector<const ShaderExport*> callChain;  // the shaders running on this launch, outermost first
+    GpuVirtualAddress lastTlasAddress = 0;  // one-entry cache of the TLAS lookup
+    const TopLevelAS* lastTlas = nullptr;
+    // Statistics beyond `stats`, in forms cheap to update; folded into `stats` when the dispatch ends.
+    std::vector<ExportCount> exportCounts;  // in first-call order: a handful of exports, searched linearly
+    bool profiling = false;                 // DispatchOptions::profileStages
+    StageClock clock;
+    LookupCache lookups;
+};
+
+// Charges this thread's time to `stage` while alive, when profiling; otherwise one untaken branch each way.
+class ProfileScope {
+public:
+    ProfileScope(ThreadState& ts, ProfileStage stage) : ts_(ts) {
+        if (ts_.profiling) previous_ = ts_.clock.enter(uint8_t(stage));
+    }
+    ~ProfileScope() {
+        if (ts_.profiling) ts_.clock.enter(previous_);
+    }
+    ProfileScope(const ProfileScope&) = delete;
+    ProfileScope& operator=(const ProfileScope&) = delete;
+
+private:
+    ThreadState& ts_;
+    uint8_t previous_ = StageClock::kOutside;
+};
+
+}  // namespace refray::dxr::detail
