@@ -1,4 +1,4 @@
-// Conformance tests for emulator/dispatcher.cpp: TraceRay, the TRV-4 hit-processing loop,
+// Conformance tests for the dispatcher (emulator/dispatcher.cpp, trace_ray.cpp, candidate_*.cpp, record_lookup.cpp): TraceRay, the TRV-4 hit-processing loop,
 // intersection/any-hit/closest-hit/miss/callable control flow and the system-value
 // intrinsics (dxr-semantics.md sections 0, 4-11 and LIM-2). Each test name carries the
 // rule id it checks.

@@ -1,4 +1,4 @@
-// Tests what scenes/scene_loader.cpp and scenes/scene.cpp add for models and the path tracer: "models" from OBJ
+// Tests what scenes/scene_loader.cpp (and scenes/loader/) and scenes/scene.cpp add for models and the path tracer: "models" from OBJ
 // files, BLAS geometry from a model, the generated model buffers, InstanceID defaulting to the object index,
 // unbounded texture ranges, static samplers, the dxr-path-tracer library's constants and its spp, and the errors of
 // broken files (file:line:column, "did you mean"). The scene files are small and written here, beside a two-object

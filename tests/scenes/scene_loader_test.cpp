@@ -1,4 +1,4 @@
-// Tests scenes/scene_loader.cpp: the two reference scene files as the fact sheets describe them, and the
+// Tests scenes/scene_loader.cpp (and scenes/loader/): the two reference scene files as the fact sheets describe them, and the
 // errors a broken file gets (file:line:column, what was expected, "did you mean").
 #include <gtest/gtest.h>
 

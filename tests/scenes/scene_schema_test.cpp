@@ -1,4 +1,4 @@
-// Tests docs/scene-format.schema.json and docs/scene-format.md against scenes/scene_loader.cpp: the reference scene
+// Tests docs/scene-format.schema.json and docs/scene-format.md against scenes/scene_loader.cpp (and scenes/loader/): the reference scene
 // files and the documented example validate, the example loads and renders, and broken files fail both the schema
 // and the loader. The JSON Schema validator below knows exactly the keywords the schema uses; any other keyword in
 // the schema is a failure, so the schema cannot lean on a keyword nobody checks.
