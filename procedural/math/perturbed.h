@@ -244,7 +244,8 @@ public:
     friend constexpr PerturbedFloat operator+(PerturbedFloat a) { return a; }
     friend constexpr PerturbedFloat operator-(PerturbedFloat a) { return PerturbedFloat(-a.v_, -a.lo_); }
 
-    friend PerturbedFloat operator+(PerturbedFloat a, PerturbedFloat b) {
+    // Add and multiply are forced inline: the marches are mostly these two, and a call costs more than either.
+    [[gnu::always_inline]] friend PerturbedFloat operator+(PerturbedFloat a, PerturbedFloat b) {
         const float sum = a.v_ + b.v_;
         if (a.lo_ != 0.0f || b.lo_ != 0.0f)
             if (const perturbed::Context* c = perturbed::current(); c && c->contracts()) {
@@ -258,7 +259,7 @@ public:
         return PerturbedFloat(sum);
     }
     friend PerturbedFloat operator-(PerturbedFloat a, PerturbedFloat b) { return a + -b; }
-    friend PerturbedFloat operator*(PerturbedFloat a, PerturbedFloat b) {
+    [[gnu::always_inline]] friend PerturbedFloat operator*(PerturbedFloat a, PerturbedFloat b) {
         PerturbedFloat r(a.v_ * b.v_);
         if (std::isfinite(r.v_)) r.lo_ = float(double(a.v_) * double(b.v_) - double(r.v_));
         return r;
@@ -367,10 +368,9 @@ struct refray::procedural::hlsl::ScalarOps<refray::procedural::PerturbedFloat> {
             for (glm::length_t i = 0; i < N; ++i)
                 words = std::rotl((words ^ perturbed::bits(a[i].value(), b[i].value())) * 0x9E3779B97F4A7C15ull, 29);
             uint64_t h = c->hash(perturbed::Op::DotOrder, words);
-            for (glm::length_t i = N - 1; i > 0; --i) {
-                std::swap(order[size_t(i)], order[size_t(h % uint64_t(i + 1))]);
-                h /= uint64_t(i + 1);
-            }
+            // Fisher-Yates, a 16-bit slice of the hash per step scaled to [0, i] (a multiply, not a division).
+            for (glm::length_t i = N - 1; i > 0; --i, h >>= 16)
+                std::swap(order[size_t(i)], order[size_t(((h & 0xFFFF) * uint64_t(i + 1)) >> 16)]);
         }
         T s = a[order[0]] * b[order[0]];
         for (size_t i = 1; i < order.size(); ++i) s = s + a[order[i]] * b[order[i]];
