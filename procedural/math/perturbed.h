@@ -249,8 +249,8 @@ public:
         const float sum = a.v_ + b.v_;
         if (a.lo_ != 0.0f || b.lo_ != 0.0f)
             if (const perturbed::Context* c = perturbed::current(); c && c->contracts()) {
-                // A fused p*q + r: the exact product (value + error, exact in double) plus r, rounded once more.
-                // Both results are computed and one is selected, sparing a branch on a coin flip.
+                // A fused p*q + r: the rounded product plus r plus the product's rounding error, summed in double
+                // and rounded to float. Both results are computed and one selected, sparing a branch on a coin flip.
                 const perturbed::Fusion f = perturbed::fusion(*c, a.v_, a.lo_ != 0.0f, b.v_, b.lo_ != 0.0f);
                 const float lo = perturbed::select(f.withA, a.lo_, b.lo_);
                 const float fused = float((double(a.v_) + double(b.v_)) + double(lo));
