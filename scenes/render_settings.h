@@ -13,6 +13,7 @@
 #include "emulator/device.h"
 #include "emulator/dispatcher.h"
 #include "procedural/accuracy.h"
+#include "procedural/perturbation.h"
 #include "procedural/precision.h"
 
 namespace refray::scenes {
@@ -36,6 +37,9 @@ struct RenderSettings {
     std::string camera;         // empty: the scene's default camera
     std::optional<float> time;  // empty: the scene's default time
     procedural::Precision precision = procedural::Precision::Float;
+    // Runs the shader math as the GPU this perturbation picks from the variation model (procedural/perturbation.h,
+    // docs/numerical-variation.md); float precision only. Unset: the nominal float or double arithmetic.
+    std::optional<procedural::Perturbation> perturbation;
     // The shader library's accuracy knobs (scenes/knobs.h); the default is the HLSL's constants.
     procedural::Accuracy accuracy;
     // Samples per pixel: a square number n = k·k renders a k-times larger dispatch whose k x k pixel centres

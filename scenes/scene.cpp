@@ -170,14 +170,16 @@ Scene::Pipeline& Scene::pipelineFor(const LibraryOptions& options) {
     const ShaderLibraryBinding& binding = findShaderLibrary(desc_.shaderLibrary);
 
     StateObjectDesc so;
-    so.name = desc_.name + " (" + std::string(procedural::toString(options.precision)) + ")";
+    so.name = desc_.name + " (" + std::string(procedural::toString(options.precision)) +
+              (options.perturbation ? ", perturbed seed " + std::to_string(options.perturbation->seed) : "") + ")";
     std::vector<procedural::TraceRayArguments> traceRay;  // what the shaders pass, per ray type
     for (const RayTypeDesc& t : desc_.rayTypes)
         traceRay.push_back({t.rayContribution, t.multiplier, t.missShaderIndex, t.instanceInclusionMask});
     // The render's knobs with the scene's effects block: its reflectionDepth (unless a knob sets the depth) and the
     // call sites it switches off.
     const procedural::Accuracy accuracy = libraryAccuracy(desc_, options.accuracy);
-    so.libraries = {{binding.make(options.precision, traceRay, accuracy, libraryEffects(desc_)), {}}};
+    so.libraries = {
+        {binding.make(options.precision, traceRay, accuracy, libraryEffects(desc_), options.perturbation), {}}};
     so.hitGroups = desc_.hitGroups;
     for (size_t i = 0; i < localSignatures_.size(); ++i)
         if (!desc_.localAssociations[i].empty())
@@ -285,7 +287,7 @@ RenderResult Scene::render(const RenderSettings& settings) {
     const float time = settings.time.value_or(desc_.defaultTime);
     REFRAY_CHECK(std::isfinite(time) && time >= 0.0f, "--time must be a finite, non-negative number of seconds, got " << time);
     const CameraDesc& camera = desc_.camera(settings.camera);
-    Pipeline& pipeline = pipelineFor({settings.precision, settings.accuracy});
+    Pipeline& pipeline = pipelineFor({settings.precision, settings.accuracy, settings.perturbation});
 
     Image target(width, height);
     std::vector<GpuVirtualAddress> frameAddresses(desc_.buffers.size(), 0);
@@ -364,6 +366,7 @@ RenderResult Scene::render(const RenderSettings& settings) {
         meta["time"] = std::string(text, end.ptr);
     }
     meta["precision"] = std::string(procedural::toString(settings.precision));
+    if (settings.perturbation) meta["perturbation"] = procedural::describe(*settings.perturbation);
     meta["spp"] = std::to_string(settings.spp);
     if (settings.seed) meta["seed"] = std::to_string(settings.seed);
     meta["knobs"] = describeKnobs(settings);

@@ -28,10 +28,10 @@ public:
     // The state object and tables of `precision` and `accuracy` (the render's knobs; the scene's effects block is
     // applied on top, scenes/effects.h), built on first use.
     const dxr::StateObjectPtr& pipeline(procedural::Precision precision, const procedural::Accuracy& accuracy = {}) {
-        return pipelineFor({precision, accuracy}).stateObject;
+        return pipelineFor({precision, accuracy, std::nullopt}).stateObject;
     }
     const dxr::DispatchRaysDesc& tables(procedural::Precision precision, const procedural::Accuracy& accuracy = {}) {
-        return pipelineFor({precision, accuracy}).tables;
+        return pipelineFor({precision, accuracy, std::nullopt}).tables;
     }
 
 private:
@@ -43,6 +43,7 @@ private:
     struct LibraryOptions {
         procedural::Precision precision = procedural::Precision::Float;
         procedural::Accuracy accuracy;
+        std::optional<procedural::Perturbation> perturbation;
         friend auto operator<=>(const LibraryOptions&, const LibraryOptions&) = default;
     };
     Pipeline& pipelineFor(const LibraryOptions& options);

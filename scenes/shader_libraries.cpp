@@ -141,10 +141,13 @@ std::shared_ptr<dxr::ShaderLibrary> makePathTracer(procedural::Precision precisi
                                                    const std::vector<procedural::TraceRayArguments>& traceRay,
                                                    const procedural::Accuracy& accuracy,
                                                    const procedural::Effects& effects,
+                                                   const std::optional<procedural::Perturbation>& perturbation,
                                                    const std::vector<procedural::TraceRayArguments>& defaults) {
     REFRAY_CHECK(precision == procedural::Precision::Float,
                  "the dxr-path-tracer shaders exist in float only (the GPU's precision); --precision double is for "
                  "the procedural libraries");
+    REFRAY_CHECK(!perturbation, "the dxr-path-tracer shaders exist in nominal float only; --perturb is for the "
+                                "procedural libraries");
     REFRAY_CHECK(traceRay == defaults, "the dxr-path-tracer shaders pass fixed TraceRay arguments (R = ray type, "
                                        "M = 2, miss index = ray type, mask 0xFF)");
     REFRAY_CHECK(accuracy.isDefault(), "the dxr-path-tracer shaders have no accuracy knobs (steps, thresholds, "
@@ -162,8 +165,9 @@ ShaderLibraryBinding pathTracerBinding() {
                           {pt::RayType::Shadow, pt::kGeometryStride, pt::RayType::Shadow, 0xFF}};
     b.make = [defaults = b.traceRayDefaults](procedural::Precision p,
                                              const std::vector<procedural::TraceRayArguments>& traceRay,
-                                             const procedural::Accuracy& accuracy, const procedural::Effects& effects) {
-        return makePathTracer(p, traceRay, accuracy, effects, defaults);
+                                             const procedural::Accuracy& accuracy, const procedural::Effects& effects,
+                                             const std::optional<procedural::Perturbation>& perturbation) {
+        return makePathTracer(p, traceRay, accuracy, effects, perturbation, defaults);
     };
     b.sceneConstants = pathTracerConstants;
     b.hasDebugFlag = true;
@@ -183,9 +187,10 @@ ShaderLibraryBinding d3d12Binding() {
     b.name = "d3d12-procedural-geometry";
     b.description = "Microsoft D3D12RaytracingProceduralGeometry Raytracing.hlsl (procedural/d3d12/)";
     b.make = [](procedural::Precision p, const std::vector<procedural::TraceRayArguments>& traceRay,
-                const procedural::Accuracy& accuracy, const procedural::Effects& effects) {
+                const procedural::Accuracy& accuracy, const procedural::Effects& effects,
+                const std::optional<procedural::Perturbation>& perturbation) {
         return procedural::d3d12::makeD3D12ShaderLibrary(p, argumentSet(traceRay, "d3d12-procedural-geometry"),
-                                                         accuracy, effects);
+                                                         accuracy, effects, perturbation);
     };
     b.sceneConstants = d3d12Constants;
     b.hasDebugFlag = false;
@@ -200,9 +205,10 @@ ShaderLibraryBinding procedurayBinding() {
     b.name = "proceduray";
     b.description = "Proceduray MandelJuliaPac Raytracing.hlsl (procedural/proceduray/)";
     b.make = [](procedural::Precision p, const std::vector<procedural::TraceRayArguments>& traceRay,
-                const procedural::Accuracy& accuracy, const procedural::Effects& effects) {
+                const procedural::Accuracy& accuracy, const procedural::Effects& effects,
+                const std::optional<procedural::Perturbation>& perturbation) {
         return procedural::proceduray::makeProcedurayShaderLibrary(p, argumentSet(traceRay, "proceduray"), accuracy,
-                                                                   effects);
+                                                                   effects, perturbation);
     };
     b.sceneConstants = procedurayConstants;
     b.hasDebugFlag = true;

@@ -5,13 +5,17 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "core/math.h"
 #include "emulator/state_object.h"
 #include "procedural/accuracy.h"
 #include "procedural/effects.h"
+#include "procedural/perturbation.h"
 #include "procedural/precision.h"
 #include "procedural/sample_layout.h"
 #include "procedural/trace_ray_parameters.h"
@@ -69,16 +73,38 @@ struct ShaderLibraryFacts {
     std::vector<ShaderEffectUse> uses;
 };
 
+// ShaderLibraryBinding::make: a library's maker, called with or without a perturbation (without: the nominal
+// arithmetic, as the callers that only build the shaders as written ask for it).
+class ShaderLibraryMaker {
+public:
+    using Function = std::function<std::shared_ptr<dxr::ShaderLibrary>(
+        procedural::Precision, const std::vector<procedural::TraceRayArguments>&, const procedural::Accuracy&,
+        const procedural::Effects&, const std::optional<procedural::Perturbation>&)>;
+
+    ShaderLibraryMaker() = default;
+    template <class F>
+        requires std::is_constructible_v<Function, F>
+    ShaderLibraryMaker(F function) : function_(std::move(function)) {}
+
+    std::shared_ptr<dxr::ShaderLibrary> operator()(
+        procedural::Precision precision, const std::vector<procedural::TraceRayArguments>& traceRay,
+        const procedural::Accuracy& accuracy, const procedural::Effects& effects,
+        const std::optional<procedural::Perturbation>& perturbation = std::nullopt) const {
+        return function_(precision, traceRay, accuracy, effects, perturbation);
+    }
+
+private:
+    Function function_;
+};
+
 struct ShaderLibraryBinding {
     std::string name;         // what scene files write in "shaderLibrary"
     std::string description;  // which HLSL it ports
     // Makes the library with its shaders' TraceRay arguments, one entry per ray type (exactly rayTypeCount; other
-    // counts throw refray::Error), its accuracy knobs and the effects switched off. `traceRayDefaults` gives the
-    // library's own TraceRay arguments; Accuracy{} and Effects{} give the HLSL's.
-    std::function<std::shared_ptr<dxr::ShaderLibrary>(procedural::Precision,
-                                                      const std::vector<procedural::TraceRayArguments>&,
-                                                      const procedural::Accuracy&, const procedural::Effects&)>
-        make;
+    // counts throw refray::Error), its accuracy knobs, the effects switched off and its perturbation (unset: the
+    // nominal arithmetic). `traceRayDefaults` gives the library's own TraceRay arguments; Accuracy{} and Effects{}
+    // give the HLSL's.
+    ShaderLibraryMaker make;
     // The bytes of the library's SceneConstantBuffer (its C++ struct, padding zeroed).
     std::function<std::vector<uint8_t>(const SceneConstantsInput&)> sceneConstants;
     bool hasDebugFlag = false;

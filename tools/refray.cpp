@@ -20,6 +20,7 @@
 #include "core/statistical_compare.h"
 #include "core/strings.h"
 #include "emulator/validation.h"
+#include "procedural/perturbation.h"
 #include "procedural/precision.h"
 #include "scenes/builtin_scene.h"
 #include "scenes/effects.h"
@@ -176,6 +177,8 @@ struct RenderOptions {
     std::string camera;
     std::optional<float> time;
     std::string precision = "float";
+    std::optional<uint64_t> perturb;  // --perturb SEED: RenderSettings::perturbation
+    std::optional<std::string> perturbContraction, perturbDenormals;
     uint32_t spp = 1;
     uint32_t orderCheck = 0;
     std::string aov;
@@ -234,6 +237,30 @@ StatisticsImage renderBatches(const std::function<scenes::RenderResult(const sce
     return stats;
 }
 
+// --perturb SEED with its --perturb-contraction and --perturb-denormals; unset without --perturb.
+std::optional<procedural::Perturbation> perturbationOf(const RenderOptions& o) {
+    if (!o.perturb) {
+        REFRAY_CHECK(!o.perturbContraction && !o.perturbDenormals,
+                     "--perturb-contraction and --perturb-denormals shape a perturbed render: give them with --perturb "
+                     "SEED");
+        return std::nullopt;
+    }
+    procedural::Perturbation p;
+    p.seed = *o.perturb;
+    if (o.perturbContraction) {
+        const std::optional<procedural::Contraction> c = procedural::parseContraction(*o.perturbContraction);
+        REFRAY_CHECK(c, "--perturb-contraction expects 'split', 'fuse' or 'mixed', got '" << *o.perturbContraction
+                                                                                            << "'");
+        p.contraction = *c;
+    }
+    if (o.perturbDenormals) {
+        const std::optional<procedural::Denormals> d = procedural::parseDenormals(*o.perturbDenormals);
+        REFRAY_CHECK(d, "--perturb-denormals expects 'flush' or 'preserve', got '" << *o.perturbDenormals << "'");
+        p.denormals = *d;
+    }
+    return p;
+}
+
 int runRender(const RenderOptions& o) {
     scenes::RenderSettings settings;
     settings.threads = o.threads;
@@ -263,6 +290,7 @@ int runRender(const RenderOptions& o) {
     const std::optional<procedural::Precision> precision = procedural::parsePrecision(o.precision);
     REFRAY_CHECK(precision, "--precision expects 'float' or 'double', got '" << o.precision << "'");
     settings.precision = *precision;
+    settings.perturbation = perturbationOf(o);
     settings.spp = o.spp;
     for (const std::string& k : o.knobs) scenes::applyKnobAssignment(settings, k);
     settings.profileStages = (o.stats || !o.statsJson.empty()) && !o.noStageTimes;
@@ -276,10 +304,11 @@ int runRender(const RenderOptions& o) {
     scenes::EffectSet effectSet;
     std::vector<scenes::Effect> effects;  // of a scene file (the built-in scene has none to report)
     if (o.scene == "builtin") {
-        REFRAY_CHECK(o.camera.empty() && !o.time && o.spp == 1 && o.precision == "float" && o.orderCheck == 0 && o.aov.empty() &&
-                         o.knobs.empty(),
+        REFRAY_CHECK(o.camera.empty() && !o.time && o.spp == 1 && o.precision == "float" && !o.perturb &&
+                         o.orderCheck == 0 && o.aov.empty() && o.knobs.empty(),
                      "the built-in scene has one camera, no time, one sample per pixel and float shaders; "
-                     "--camera, --time, --spp, --precision, --knob, --order-check and --aov are for scene files");
+                     "--camera, --time, --spp, --precision, --perturb, --knob, --order-check and --aov are for scene "
+                     "files");
         const Size size = parseSize(o.size.empty() ? "640x360" : o.size);
         settings.width = size.width, settings.height = size.height;
         device = tools::useRenderDevice(o.device, "builtin", o.spirvDir, settings);
@@ -382,6 +411,15 @@ int main(int argc, char** argv) {
         ->check(tools::seconds());
     render->add_option("--precision", ro.precision, "Shader math precision: float (the GPU's) or double")
         ->capture_default_str();
+    render->add_option("--perturb", ro.perturb,
+                       "Render as the GPU that SEED picks from the variation model (docs/numerical-variation.md): "
+                       "every inexact float operation gets an error within the specs' bound; float precision only");
+    render->add_option("--perturb-contraction", ro.perturbContraction,
+                       "With --perturb: a*b+c computed split, fused, or mixed (each operation as the seed decides; "
+                       "the default)");
+    render->add_option("--perturb-denormals", ro.perturbDenormals,
+                       "With --perturb: denormal floats flushed to zero (the default, as D3D11.3 requires) or "
+                       "preserved (what DXIL's default denorm mode also allows)");
     render->add_option("--spp", ro.spp, "Samples per pixel: a square number (k x k pixel centres of a k-times larger "
                                         "dispatch, averaged); for dxr-path-tracer scenes any N (random paths per "
                                         "pixel, averaged by the shader)")

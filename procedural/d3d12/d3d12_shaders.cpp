@@ -9,6 +9,7 @@
 #include "procedural/math/analytic.h"
 #include "procedural/math/hlsl.h"
 #include "procedural/math/metaballs.h"
+#include "procedural/math/perturbed.h"
 #include "procedural/math/ray.h"
 #include "procedural/math/sdf.h"
 
@@ -475,48 +476,51 @@ void MyIntersectionShader_SignedDistancePrimitive(ShaderContext& ctx, const Accu
 }
 
 // Every export, with its math in T. The lambdas hold copies of the TraceRay arguments and the Accuracy, which the
-// shaders take by reference.
+// shaders take by reference; a PerturbedFloat library's also hold its perturbation (withArithmetic).
 template <typename T>
 void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                const Effects& effects) {
-    lib.addRayGeneration("MyRaygenShader",
-                         [traceRay, accuracy](ShaderContext& ctx) { MyRaygenShader<T>(ctx, traceRay, accuracy); });
+                const Effects& effects, const std::optional<Perturbation>& perturbation) {
+    const auto in = [&perturbation](auto entry) { return withArithmetic<T>(perturbation, entry); };
+    lib.addRayGeneration("MyRaygenShader", in([traceRay, accuracy](ShaderContext& ctx) {
+                             MyRaygenShader<T>(ctx, traceRay, accuracy);
+                         }));
     lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
-        "MyClosestHitShader_Triangle", [traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
-                                                                     const BuiltInTriangleIntersectionAttributes& attr) {
+        "MyClosestHitShader_Triangle",
+        in([traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
+                                         const BuiltInTriangleIntersectionAttributes& attr) {
             MyClosestHitShader_Triangle<T>(ctx, traceRay, accuracy, effects, payload, attr);
-        });
+        }));
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "MyClosestHitShader_AABB",
-        [traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
-                                      const ProceduralPrimitiveAttributes& attr) {
+        in([traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
+                                         const ProceduralPrimitiveAttributes& attr) {
             MyClosestHitShader_AABB<T>(ctx, traceRay, accuracy, effects, payload, attr);
-        });
+        }));
     lib.addMiss<RayPayload>("MyMissShader", MyMissShader);
     lib.addMiss<ShadowRayPayload>("MyMissShader_ShadowRay", MyMissShader_ShadowRay);
     // Each intersection shader's ReportHit is its last action, as in the HLSL: ReportHitEnd::Return spares the unwind
     // when a shadow ray's hit ends the search (docs/emulator.md, "Ending an intersection shader").
     lib.addIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_AnalyticPrimitive",
-        [](ShaderContext& ctx) { MyIntersectionShader_AnalyticPrimitive<T>(ctx); },
-        ReportHitEnd::Return);
+        in([](ShaderContext& ctx) { MyIntersectionShader_AnalyticPrimitive<T>(ctx); }), ReportHitEnd::Return);
     lib.addIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_VolumetricPrimitive",
-        [accuracy](ShaderContext& ctx) { MyIntersectionShader_VolumetricPrimitive<T>(ctx, accuracy); },
+        in([accuracy](ShaderContext& ctx) { MyIntersectionShader_VolumetricPrimitive<T>(ctx, accuracy); }),
         ReportHitEnd::Return);
     lib.addIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_SignedDistancePrimitive",
-        [accuracy](ShaderContext& ctx) { MyIntersectionShader_SignedDistancePrimitive<T>(ctx, accuracy); },
+        in([accuracy](ShaderContext& ctx) { MyIntersectionShader_SignedDistancePrimitive<T>(ctx, accuracy); }),
         ReportHitEnd::Return);
 }
 
 }  // namespace
 
 std::shared_ptr<ShaderLibrary> makeD3D12ShaderLibrary(Precision precision, const TraceRayArgumentSet& traceRay,
-                                                      const Accuracy& accuracy, const Effects& effects) {
+                                                      const Accuracy& accuracy, const Effects& effects,
+                                                      const std::optional<Perturbation>& perturbation) {
     auto lib = std::make_shared<ShaderLibrary>();
-    if (precision == Precision::Double) addExports<double>(*lib, traceRay, accuracy, effects);
-    else addExports<float>(*lib, traceRay, accuracy, effects);
+    forScalarType(precision, perturbation,
+                  [&]<typename T>() { addExports<T>(*lib, traceRay, accuracy, effects, perturbation); });
     return lib;
 }
 

@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "core/math.h"
@@ -27,6 +28,7 @@
 #include "procedural/effects.h"
 #include "procedural/math/fractals.h"
 #include "procedural/math/metaballs.h"
+#include "procedural/perturbation.h"
 #include "procedural/precision.h"
 #include "procedural/sample_layout.h"
 #include "procedural/trace_ray_parameters.h"
@@ -188,9 +190,12 @@ std::vector<std::string> aabbHitGroupNames();
 // PORT: `accuracy` replaces the HLSL's march constants (procedural/accuracy.h); the default is the HLSL's.
 // PORT: `effects` switches call sites off (procedural/effects.h): with traceShadowRays false, both closest hits take
 // every point as lit without tracing; the default is the HLSL's.
+// PORT: `perturbation` (float only) runs the math in PerturbedFloat: the GPU that seed picks from the variation
+// model (procedural/math/perturbed.h, docs/numerical-variation.md); unset: float or double as `precision` says.
 std::shared_ptr<dxr::ShaderLibrary> makeD3D12ShaderLibrary(
     Precision precision = Precision::Float, const TraceRayArgumentSet& traceRay = defaultTraceRayArguments(),
-    const Accuracy& accuracy = {}, const Effects& effects = {});
+    const Accuracy& accuracy = {}, const Effects& effects = {},
+    const std::optional<Perturbation>& perturbation = std::nullopt);
 
 // ---- The ground plane's index and vertex buffers (§1.2) ----------------------------------------------
 // What the app uploads as g_indices (6 16-bit indices, a raw view) and g_vertices (4 vertices, stride 24), which

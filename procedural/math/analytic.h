@@ -142,8 +142,8 @@ template <typename T>
 bool RayAABBIntersectionTest(const Ray<T>& ray, const vec3<T> aabb[2], const RayExtent<T>& extent, T& tmin,
                              T& tmax) {
     constexpr T inf = std::numeric_limits<T>::infinity();
-    vec3<T> tmin3;
-    vec3<T> tmax3;
+    vec3<T> tmin3{};  // every component is set below; {} spares GCC a false maybe-uninitialized
+    vec3<T> tmax3{};
     for (glm::length_t k = 0; k < 3; ++k) {
         const T d = ray.direction[k];
         const T o = ray.origin[k];

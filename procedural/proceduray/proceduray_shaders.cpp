@@ -7,6 +7,7 @@
 #include "emulator/shader_api.h"
 #include "procedural/math/fractals.h"
 #include "procedural/math/hlsl.h"
+#include "procedural/math/perturbed.h"
 #include "procedural/math/ray.h"
 #include "procedural/math/sdf.h"
 
@@ -589,54 +590,57 @@ void ClosestHit_Julia(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, c
 }
 
 // Every export, with its math in T. The lambdas hold copies of the TraceRay arguments and the Accuracy, which the
-// shaders take by reference.
+// shaders take by reference; a PerturbedFloat library's also hold its perturbation (withArithmetic).
 template <typename T>
 void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                const Effects& effects) {
-    lib.addRayGeneration("Raygen", [traceRay, accuracy](ShaderContext& ctx) { Raygen<T>(ctx, traceRay, accuracy); });
+                const Effects& effects, const std::optional<Perturbation>& perturbation) {
+    const auto in = [&perturbation](auto entry) { return withArithmetic<T>(perturbation, entry); };
+    lib.addRayGeneration("Raygen",
+                         in([traceRay, accuracy](ShaderContext& ctx) { Raygen<T>(ctx, traceRay, accuracy); }));
     lib.addMiss<RayPayload>("Miss", Miss);
     lib.addMiss<ShadowRayPayload>("Miss_Shadow", Miss_Shadow);
     lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
-        "ClosestHit_Triangle", [traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
-                                                             const BuiltInTriangleIntersectionAttributes& attr) {
+        "ClosestHit_Triangle", in([traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
+                                                                const BuiltInTriangleIntersectionAttributes& attr) {
             ClosestHit_Triangle<T>(ctx, traceRay, accuracy, effects, payload, attr);
-        });
+        }));
     // Each intersection shader below ends with its ReportHit (the debug-flag path returns right after it), as in
     // the HLSL: ReportHitEnd::Return (docs/emulator.md, "Ending an intersection shader").
     lib.addIntersection<ProceduralPrimitiveAttributes>(
-        "Intersection_Julia", [accuracy](ShaderContext& ctx) { Intersection_Julia<T>(ctx, accuracy); },
+        "Intersection_Julia", in([accuracy](ShaderContext& ctx) { Intersection_Julia<T>(ctx, accuracy); }),
         ReportHitEnd::Return);
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Julia",
-        [traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
+        in([traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
             ClosestHit_Julia<T>(ctx, traceRay, accuracy, payload, attr);
-        });
+        }));
     lib.addIntersection<ProceduralPrimitiveAttributes>(
-        "Intersection_Pacman", [accuracy](ShaderContext& ctx) { Intersection_Pacman<T>(ctx, accuracy); },
+        "Intersection_Pacman", in([accuracy](ShaderContext& ctx) { Intersection_Pacman<T>(ctx, accuracy); }),
         ReportHitEnd::Return);
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Pacman",
-        [traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
-                                      const ProceduralPrimitiveAttributes& attr) {
+        in([traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
+                                         const ProceduralPrimitiveAttributes& attr) {
             ClosestHit_Pacman<T>(ctx, traceRay, accuracy, effects, payload, attr);
-        });
+        }));
     lib.addIntersection<ProceduralPrimitiveAttributes>(
-        "Intersection_Mandelbulb", [accuracy](ShaderContext& ctx) { Intersection_Mandelbulb<T>(ctx, accuracy); },
-        ReportHitEnd::Return);
+        "Intersection_Mandelbulb",
+        in([accuracy](ShaderContext& ctx) { Intersection_Mandelbulb<T>(ctx, accuracy); }), ReportHitEnd::Return);
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Mandelbulb",
-        [traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
+        in([traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
             ClosestHit_Mandelbulb<T>(ctx, traceRay, accuracy, payload, attr);
-        });
+        }));
 }
 
 }  // namespace
 
 std::shared_ptr<ShaderLibrary> makeProcedurayShaderLibrary(Precision precision, const TraceRayArgumentSet& traceRay,
-                                                      const Accuracy& accuracy, const Effects& effects) {
+                                                            const Accuracy& accuracy, const Effects& effects,
+                                                            const std::optional<Perturbation>& perturbation) {
     auto lib = std::make_shared<ShaderLibrary>();
-    if (precision == Precision::Double) addExports<double>(*lib, traceRay, accuracy, effects);
-    else addExports<float>(*lib, traceRay, accuracy, effects);
+    forScalarType(precision, perturbation,
+                  [&]<typename T>() { addExports<T>(*lib, traceRay, accuracy, effects, perturbation); });
     return lib;
 }
 

@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "core/math.h"
@@ -25,6 +26,7 @@
 #include "procedural/accuracy.h"
 #include "procedural/effects.h"
 #include "procedural/math/fractals.h"
+#include "procedural/perturbation.h"
 #include "procedural/precision.h"
 #include "procedural/sample_layout.h"
 #include "procedural/trace_ray_parameters.h"
@@ -164,9 +166,12 @@ std::vector<dxr::HitGroupDesc> procedurayHitGroups();
 // PORT: `accuracy` replaces the HLSL's march constants (procedural/accuracy.h); the default is the HLSL's.
 // PORT: `effects` switches call sites off (procedural/effects.h): with traceShadowRays false, ClosestHit_Triangle and
 // ClosestHit_Pacman take every point as lit without tracing; the default is the HLSL's.
+// PORT: `perturbation` (float only) runs the math in PerturbedFloat: the GPU that seed picks from the variation
+// model (procedural/math/perturbed.h, docs/numerical-variation.md); unset: float or double as `precision` says.
 std::shared_ptr<dxr::ShaderLibrary> makeProcedurayShaderLibrary(
     Precision precision = Precision::Float, const TraceRayArgumentSet& traceRay = defaultTraceRayArguments(),
-    const Accuracy& accuracy = {}, const Effects& effects = {});
+    const Accuracy& accuracy = {}, const Effects& effects = {},
+    const std::optional<Perturbation>& perturbation = std::nullopt);
 
 // ---- The slab's index and vertex buffers (§1.1) ----------------------------------------------------
 // What the scene uploads as g_indices (36 16-bit indices = 18 dwords, a raw view) and g_vertices (8 vertices,

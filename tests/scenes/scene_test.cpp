@@ -185,5 +185,44 @@ TEST(Scene, TraceRayArgumentsOfTheSceneFileReachTheShaders) {
     EXPECT_TRUE(lesson.dispatch.diagnostics.empty());  // wrong records, but valid ones
 }
 
+// Perturbed renders (procedural/math/perturbed.h): a seed picks one GPU, whose image is the same at any thread count;
+// another seed is another GPU; the nominal image is the same before and after them.
+TEST(Scene, PerturbedRendersDependOnTheSeedAlone) {
+    for (const std::string& path : {kProceduray, kD3D12}) {
+        auto scene = loadScene(path);
+        const RenderResult nominal = scene->render(small());
+        RenderSettings s = small(1);
+        s.perturbation = procedural::Perturbation{1};
+        const RenderResult one = scene->render(s);
+        s.threads = 2;
+        const RenderResult two = scene->render(s);
+        s.perturbation->seed = 2;
+        const RenderResult other = scene->render(s);
+        EXPECT_TRUE(sameBytes(one.image, two.image)) << path;
+        EXPECT_FALSE(sameBytes(one.image, other.image)) << path;
+        EXPECT_FALSE(sameBytes(one.image, nominal.image)) << path;
+        EXPECT_EQ(nonFinitePixels(one.image), 0u) << path;
+        EXPECT_TRUE(one.dispatch.diagnostics.empty()) << path;
+        EXPECT_EQ(one.image.metadata.at("perturbation"),
+                  "seed 1, contraction mixed, denormals flush (variation model v1)");
+        EXPECT_EQ(nominal.image.metadata.count("perturbation"), 0u);
+        EXPECT_TRUE(sameBytes(scene->render(small()).image, nominal.image)) << path;
+    }
+}
+
+TEST(Scene, PerturbedDoublePrecisionIsRefused) {
+    auto scene = loadScene(kD3D12);
+    RenderSettings s = small();
+    s.precision = procedural::Precision::Double;
+    s.perturbation = procedural::Perturbation{3};
+    try {
+        scene->render(s);
+        FAIL() << "a perturbed double render must be refused";
+    } catch (const Error& e) {
+        EXPECT_STREQ(e.what(), "a perturbed render perturbs the GPU's float arithmetic; --perturb cannot be combined "
+                               "with --precision double");
+    }
+}
+
 }  // namespace
 }  // namespace refray::scenes
