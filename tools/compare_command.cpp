@@ -1,6 +1,8 @@
 #include "tools/compare_command.h"
 
 #include <algorithm>
+#include <chrono>
+#include <optional>
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
@@ -9,6 +11,8 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/hash.h"
+#include "verify/golden.h"
 #include "core/statistical_compare.h"
 #include "core/strings.h"
 #include "tools/cli_common.h"
@@ -125,8 +129,10 @@ for (const candidate of document.querySelectorAll('img.candidate')) {
 CLI::App* addCompareCommand(CLI::App& app, CompareCommandOptions& o) {
     auto* sub = app.add_subcommand("compare", "Compare a render (CANDIDATE) to a golden image (REFERENCE), as idiff does");
     sub->footer(kFooter);
-    sub->add_option("reference", o.reference, "Reference image; ref-*.ext beside it are accepted variants")->required();
-    sub->add_option("candidate", o.candidate, "Candidate image (e.g. your GPU back end's render)")->required();
+    sub->add_option("reference", o.reference, "Reference image; ref-*.ext beside it are accepted variants (with "
+                                              "--golden DIR-or-envelope: the candidate; with --golden-set: the "
+                                              "candidates' directory)");
+    sub->add_option("candidate", o.candidate, "Candidate image (e.g. your GPU back end's render)");
     CLI::Option* fail = sub->add_option("--fail", o.thresholds.fail, "A pixel fails when a channel differs by more")
                             ->check(numberAtLeastZero(false))->capture_default_str();
     CLI::Option* failPercent =
@@ -143,8 +149,15 @@ CLI::App* addCompareCommand(CLI::App& app, CompareCommandOptions& o) {
     CLI::Option* hardWarn =
         sub->add_option("--hardwarn", o.thresholds.hardWarn, "Warn if any channel differs by more than this")
             ->check(numberAtLeastZero(false))->capture_default_str();
-    sub->add_flag("--golden", o.golden,
-                  "Tolerances for a GPU render against a refray golden PNG: --fail 0.005 --failpercent 0.1 --warn 0.005");
+    CLI::Option* goldenOption =
+        sub->add_option("--golden", o.goldenPath,
+                        "An envelope golden (a golden directory, or NAME.envelope.exr) to judge the candidate against; "
+                        "alone or with a plain image: the tolerances for a GPU render against a golden PNG: --fail "
+                        "0.005 --failpercent 0.1 --warn 0.005")
+            ->expected(0, 1);
+    sub->add_option("--golden-set", o.goldenSet,
+                    "A golden directory: judge every golden in it against CANDIDATES_DIR/<name>.exr or .png");
+    sub->add_option("--junit", o.junitPath, "--golden-set: write the verdicts as JUnit XML");
     sub->add_option("--channels", o.channels, "Channels compared: rgb (default; DXR samples' alpha means nothing) or rgba")
         ->check(oneOf({"rgb", "rgba"}));
     sub->add_option("--mask", o.maskPath, "Mask image: pixels with non-zero RGB are order-dependent, reported apart "
@@ -183,7 +196,23 @@ CLI::App* addCompareCommand(CLI::App& app, CompareCommandOptions& o) {
     const std::vector<CLI::Option*> statisticalOnly = {alpha, correction, map};
 
     // --golden gives the defaults; thresholds given on the command line win.
-    sub->callback([&o, fail, failPercent, hardFail, warn, warnPercent, hardWarn, thresholdOnly, statisticalOnly] {
+    sub->callback([&o, fail, failPercent, hardFail, warn, warnPercent, hardWarn, thresholdOnly, statisticalOnly,
+                   goldenOption] {
+        o.golden = goldenOption->count() > 0;
+        // --golden X CANDIDATE leaves CANDIDATE in the first positional.
+        if (!o.goldenPath.empty() || !o.goldenSet.empty()) {
+            if (!o.candidate.empty())
+                throw CLI::ValidationError(o.goldenSet.empty() ? "--golden" : "--golden-set",
+                                           "takes one more argument, the candidate (or the candidates' directory), "
+                                           "not two");
+            o.candidate = o.reference;
+            o.reference.clear();
+        }
+        if (o.candidate.empty())
+            throw CLI::ValidationError("compare", o.goldenSet.empty() ? "needs REFERENCE and CANDIDATE (or --golden "
+                                                                        "GOLDEN CANDIDATE)"
+                                                                      : "--golden-set needs the candidates' directory");
+        if (!o.junitPath.empty() && o.goldenSet.empty()) throw CLI::ValidationError("--junit", "needs --golden-set");
         const auto given = [](const std::vector<CLI::Option*>& options) {
             std::string names;
             for (const CLI::Option* option : options)
@@ -249,9 +278,281 @@ int runStatisticalCompare(const CompareCommandOptions& o) {
     }
 }
 
+
+namespace fs = std::filesystem;
+
+// The golden a directory holds for a candidate: by the candidate's name (<name>.png, <name>.exr), or the only one.
+struct GoldenFile {
+    std::string name, envelopePath;
+    std::optional<scenes::GoldenEntry> entry;
+};
+
+std::string stemOf(const std::string& path) {
+    std::string stem = fs::path(path).filename().string();
+    const size_t dot = stem.rfind('.');
+    if (dot != std::string::npos) stem.erase(dot);
+    if (stem.size() > 9 && stem.ends_with(".envelope")) stem.erase(stem.size() - 9);
+    return stem;
+}
+
+// A golden whose scene file changed since it was made is refused (the scene file is looked for from the current
+// directory and from the repository holding DIR/tests/golden); one whose scene file is not here is judged as is.
+void checkSceneUnchanged(const scenes::GoldenEntry& e, const fs::path& directory) {
+    for (const fs::path& root : {fs::path("."), directory / ".." / ".."}) {
+        const fs::path scene = root / e.scene;
+        if (!fs::is_regular_file(scene)) continue;
+        const std::string sha = sha256HexOfFile(scene);
+        REFRAY_CHECK(sha == e.sceneSha256, "the golden " << e.name << " in " << (directory / "goldens.json").string()
+                                                         << " was made from " << scene.string() << " with SHA-256 "
+                                                         << e.sceneSha256 << ", and that file has changed (SHA-256 "
+                                                         << sha << "): review the change and remake the golden with "
+                                                                   "'refray golden update' or 'refray golden make'");
+        return;
+    }
+}
+
+GoldenFile resolveGolden(const std::string& golden, const std::string& candidate) {
+    GoldenFile g;
+    if (!fs::is_directory(golden)) {
+        g.envelopePath = golden;
+        g.name = stemOf(golden);
+        return g;
+    }
+    const fs::path manifest = fs::path(golden) / "goldens.json";
+    REFRAY_CHECK(fs::exists(manifest), "the golden directory " << golden << " has no goldens.json");
+    const scenes::GoldenSet set = scenes::readGoldenManifest(manifest);
+    const std::string stem = stemOf(candidate);
+    for (const scenes::GoldenEntry& e : set.entries)
+        if (e.name == stem || set.entries.size() == 1) g.entry = e;
+    if (!g.entry) {
+        std::string names;
+        for (const scenes::GoldenEntry& e : set.entries) names += (names.empty() ? "" : ", ") + e.name;
+        REFRAY_CHECK(false, "no golden in " << manifest.string() << " is named '" << stem << "' (from the candidate "
+                                            << candidate << "); it holds: " << names);
+    }
+    checkSceneUnchanged(*g.entry, golden);
+    g.name = g.entry->name;
+    g.envelopePath = (fs::path(golden) / g.entry->envelope).string();
+    return g;
+}
+
+int writeEnvelopeOutputs(const CompareCommandOptions& o, const EnvelopeJudgement& j, const Envelope& envelope,
+                         const Image& candidate, const std::string& envelopePath) {
+    try {
+        if (!o.diffPath.empty()) {
+            if (j.heatMap.empty()) {
+                std::fprintf(stderr, "refray compare: no heat map written: %s\n", j.mismatch.c_str());
+            } else {
+                createParentDirectory(o.diffPath);
+                writeImage(o.diffPath, j.heatMap);
+                std::printf("wrote %s\n", o.diffPath.c_str());
+            }
+        }
+        if (!o.htmlPath.empty()) {
+            CompareReportRow row;
+            row.referencePath = envelopePath;
+            row.candidatePath = o.candidate;
+            row.reference = &envelope.nominal;
+            row.candidate = &candidate;
+            row.envelope = &j;
+            row.matched = true;
+            createParentDirectory(o.htmlPath);
+            writeCompareReport(o.htmlPath, j.verdict, "\"" + o.candidate + "\" against the envelope \"" + envelopePath + "\"",
+                               {row});
+            std::printf("wrote %s\n", o.htmlPath.c_str());
+        }
+    } catch (const Error& e) {
+        std::fprintf(stderr, "refray compare: %s\n", e.what());
+        return 4;
+    }
+    return int(j.verdict);
+}
+
+int runEnvelopeCompare(const CompareCommandOptions& o) {
+    GoldenFile golden;
+    Envelope envelope;
+    Image candidate;
+    try {
+        golden = resolveGolden(o.goldenPath, o.candidate);
+        envelope = readEnvelope(golden.envelopePath);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "refray compare: %s\n", e.what());
+        return 4;
+    }
+    if (!readInto(o.candidate, candidate)) return 4;
+    const EnvelopeJudgement j = judgeEnvelope(envelope, candidate, o.envelope);
+    std::printf("Judging \"%s\" against the envelope golden \"%s\" (%u renders, K = %u perturbed)\n",
+                o.candidate.c_str(), golden.envelopePath.c_str(), envelope.variants, envelope.perturbedRenders);
+    if (j.verdict == CompareVerdict::Mismatch)
+        std::fprintf(stderr, "refray compare: %s is %ux%u, the golden %s is %ux%u\n", o.candidate.c_str(),
+                     candidate.width(), candidate.height(), golden.envelopePath.c_str(), envelope.width(),
+                     envelope.height());
+    std::fputs(j.describe().c_str(), stdout);
+    std::fflush(stdout);
+    return writeEnvelopeOutputs(o, j, envelope, candidate, golden.envelopePath);
+}
+
+std::string xmlEscape(const std::string& s) {
+    std::string out;
+    for (char c : s) {
+        switch (c) {
+            case '&': out += "&amp;"; break;
+            case '<': out += "&lt;"; break;
+            case '>': out += "&gt;"; break;
+            case '"': out += "&quot;"; break;
+            default:
+                if (static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t') out += ' ';
+                else out += c;
+        }
+    }
+    return out;
+}
+
+struct SetRow {
+    std::string name, envelopePath, candidatePath, problem;  // problem: a missing candidate or unreadable golden
+    Envelope envelope;
+    Image candidate;
+    EnvelopeJudgement judgement;
+    double seconds = 0.0;
+    CompareVerdict verdict() const { return problem.empty() ? judgement.verdict : CompareVerdict::Fail; }
+};
+
+int runGoldenSet(const CompareCommandOptions& o) {
+    const fs::path directory = o.goldenSet, manifest = fs::path(o.goldenSet) / "goldens.json";
+    scenes::GoldenSet set;
+    try {
+        REFRAY_CHECK(fs::is_directory(o.goldenSet), "the golden set " << o.goldenSet << " is no directory");
+        REFRAY_CHECK(fs::exists(manifest), "the golden directory " << o.goldenSet << " has no goldens.json");
+        REFRAY_CHECK(fs::is_directory(o.candidate), "the candidates' directory " << o.candidate << " does not exist");
+        set = scenes::readGoldenManifest(manifest);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "refray compare: %s\n", e.what());
+        return 4;
+    }
+    std::vector<SetRow> rows(set.entries.size());
+    int status = 0;
+    std::printf("Judging %zu candidates in \"%s\" against the envelope goldens of \"%s\"\n", rows.size(),
+                o.candidate.c_str(), o.goldenSet.c_str());
+    for (size_t i = 0; i < set.entries.size(); ++i) {
+        const scenes::GoldenEntry& e = set.entries[i];
+        SetRow& r = rows[i];
+        const auto start = std::chrono::steady_clock::now();
+        r.name = e.name;
+        r.envelopePath = (directory / e.envelope).string();
+        for (const char* ext : {".exr", ".png"})
+            if (r.candidatePath.empty() && fs::exists(fs::path(o.candidate) / (e.name + ext)))
+                r.candidatePath = (fs::path(o.candidate) / (e.name + ext)).string();
+        try {
+            checkSceneUnchanged(e, directory);
+            r.envelope = readEnvelope(r.envelopePath);
+            if (r.candidatePath.empty()) {
+                r.problem = "no candidate: neither " + (fs::path(o.candidate) / (e.name + ".exr")).string() + " nor " +
+                            (fs::path(o.candidate) / (e.name + ".png")).string() + " exists";
+            } else {
+                r.candidate = readImage(r.candidatePath);
+                r.judgement = judgeEnvelope(r.envelope, r.candidate, o.envelope);
+            }
+        } catch (const std::exception& ex) {
+            r.problem = ex.what();
+            status = std::max(status, 4);
+        }
+        r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        status = std::max(status, int(r.verdict()));
+        std::printf("  %-48s %s", e.name.c_str(), std::string(toString(r.verdict())).c_str());
+        if (!r.problem.empty()) std::printf(": %s", r.problem.c_str());
+        else if (r.verdict() == CompareVerdict::Mismatch) std::printf(": %s", r.judgement.mismatch.c_str());
+        else
+            std::printf(" (stable outside %llu, sensitive outside %llu of allowed %llu, NaN %llu)",
+                        (unsigned long long)r.judgement.stableOutside, (unsigned long long)r.judgement.sensitiveOutside,
+                        (unsigned long long)r.judgement.sensitiveBudget, (unsigned long long)r.judgement.nonFinite);
+        std::printf("\n");
+    }
+    for (const SetRow& r : rows)
+        if (r.verdict() != CompareVerdict::Pass && r.problem.empty()) {
+            std::printf("%s against %s:\n", r.candidatePath.c_str(), r.envelopePath.c_str());
+            std::fputs(r.judgement.describe().c_str(), stdout);
+        }
+    const CompareVerdict overall = status >= 2 ? CompareVerdict::Fail : CompareVerdict(status);
+    std::printf("verdict %s\n", std::string(toString(overall)).c_str());
+    std::fflush(stdout);
+    try {
+        if (!o.htmlPath.empty()) {
+            std::vector<CompareReportRow> report;
+            for (const SetRow& r : rows) {
+                CompareReportRow row;
+                row.referencePath = r.envelopePath;
+                row.candidatePath = r.candidatePath.empty() ? "(missing)" : r.candidatePath;
+                row.reference = r.envelope.nominal.empty() ? nullptr : &r.envelope.nominal;
+                row.candidate = r.candidate.empty() ? nullptr : &r.candidate;
+                if (r.problem.empty()) row.envelope = &r.judgement;
+                else row.missing = r.problem;
+                report.push_back(row);
+            }
+            createParentDirectory(o.htmlPath);
+            writeCompareReport(o.htmlPath, overall,
+                               std::to_string(rows.size()) + " goldens of \"" + o.goldenSet + "\" against \"" +
+                                   o.candidate + "\"",
+                               std::move(report));
+            std::printf("wrote %s\n", o.htmlPath.c_str());
+        }
+        if (!o.junitPath.empty()) {
+            size_t failures = 0;
+            double total = 0.0;
+            for (const SetRow& r : rows) {
+                failures += r.verdict() >= CompareVerdict::Fail ? 1 : 0;
+                total += r.seconds;
+            }
+            std::ostringstream xml;
+            xml << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites name=\"refray compare --golden-set\" tests=\""
+                << rows.size() << "\" failures=\"" << failures << "\" time=\"" << total << "\">\n"
+                << "  <testsuite name=\"" << xmlEscape(o.goldenSet) << "\" tests=\"" << rows.size() << "\" failures=\""
+                << failures << "\" errors=\"0\" skipped=\"0\" time=\"" << total << "\">\n";
+            for (const SetRow& r : rows) {
+                xml << "    <testcase classname=\"refray.golden\" name=\"" << xmlEscape(r.name) << "\" time=\""
+                    << r.seconds << "\">\n";
+                const std::string text = r.problem.empty() ? r.judgement.describe() : r.problem;
+                if (r.verdict() >= CompareVerdict::Fail)
+                    xml << "      <failure type=\"" << toString(r.verdict()) << "\" message=\"" << toString(r.verdict())
+                        << ": " << xmlEscape(r.problem.empty() ? r.candidatePath : r.problem) << "\">"
+                        << xmlEscape(text) << "</failure>\n";
+                else
+                    xml << "      <system-out>" << xmlEscape(text) << "</system-out>\n";
+                xml << "    </testcase>\n";
+            }
+            xml << "  </testsuite>\n</testsuites>\n";
+            createParentDirectory(o.junitPath);
+            std::ofstream out(o.junitPath, std::ios::binary);
+            REFRAY_CHECK(out, "cannot write the JUnit report '" << o.junitPath << "'");
+            out << xml.str();
+            out.close();
+            REFRAY_CHECK(out, "cannot write the JUnit report '" << o.junitPath << "'");
+            std::printf("wrote %s\n", o.junitPath.c_str());
+        }
+    } catch (const Error& e) {
+        std::fprintf(stderr, "refray compare: %s\n", e.what());
+        return 4;
+    }
+    return status;
+}
+
 }  // namespace
 
-int runCompare(const CompareCommandOptions& o) {
+int runCompare(const CompareCommandOptions& given) {
+    CompareCommandOptions o = given;
+    if (!o.goldenSet.empty()) return runGoldenSet(o);
+    if (!o.goldenPath.empty()) {
+        bool envelope = fs::is_directory(o.goldenPath);
+        if (!envelope) {
+            try {
+                envelope = isEnvelopeFile(o.goldenPath);
+            } catch (const std::exception& e) {
+                std::fprintf(stderr, "refray compare: %s\n", e.what());
+                return 4;
+            }
+        }
+        if (envelope) return runEnvelopeCompare(o);
+        o.reference = o.goldenPath;  // a plain golden image: the threshold comparison under --golden's profile
+    }
     if (o.statistical) return runStatisticalCompare(o);
     try {
         // Inputs: any unreadable file is exit 4, named.
@@ -314,7 +615,7 @@ int runCompare(const CompareCommandOptions& o) {
             if (!o.htmlPath.empty()) {
                 std::vector<CompareReportRow> rows;
                 for (size_t i = 0; i < results.size(); ++i)
-                    rows.push_back({referencePaths[i], o.candidate, &references[i], &candidate, &results[i], i == best});
+                    rows.push_back({referencePaths[i], o.candidate, &references[i], &candidate, &results[i], i == best, nullptr, {}});
                 createParentDirectory(o.htmlPath);
                 writeCompareReport(o.htmlPath, result.verdict, summary, std::move(rows));
                 std::printf("wrote %s\n", o.htmlPath.c_str());
@@ -330,11 +631,25 @@ int runCompare(const CompareCommandOptions& o) {
     }
 }
 
+namespace {
+
+CompareVerdict rowVerdictOf(const CompareReportRow& row) {
+    if (row.result) return row.result->verdict;
+    if (row.envelope) return row.envelope->verdict;
+    return CompareVerdict::Fail;
+}
+
+std::string imageCell(const char* cls, const Image* image, const std::string& alt) {
+    return image ? imageTag(cls, *image, alt) : "<div class=\"caption\">no image</div>";
+}
+
+}  // namespace
+
 void writeCompareReport(const std::string& path, CompareVerdict overall, const std::string& summary,
                         std::vector<CompareReportRow> rows) {
     // Failing rows first, as Blender's render-test report does; otherwise in given order.
     std::stable_sort(rows.begin(), rows.end(), [](const CompareReportRow& a, const CompareReportRow& b) {
-        return a.result->verdict > b.result->verdict;
+        return rowVerdictOf(a) > rowVerdictOf(b);
     });
 
     std::ostringstream html;
@@ -344,28 +659,33 @@ void writeCompareReport(const std::string& path, CompareVerdict overall, const s
     html << "<h1>refray compare: <span id=\"verdict\" class=\"badge " << verdict << "\">" << verdict << "</span></h1>\n";
     html << "<p id=\"summary\">" << htmlEscape(summary) << "</p>\n";
     html << "<p>Hover over a candidate to see the reference in its place. Diffs are heat maps through the magma "
-            "ramp: black is no difference, pale yellow the largest.</p>\n";
+            "ramp: black is no difference, pale yellow the largest. Envelope heat maps show the nominal image dimmed, "
+            "red where a stable pixel moved, orange to pale yellow where a sensitive pixel left its envelope (farther: "
+            "paler), blue for order-dependent pixels outside, magenta for NaN or infinity.</p>\n";
     html << "<table id=\"comparisons\">\n<thead><tr><th>reference</th><th>candidate</th><th>diff</th><th>numbers</th>"
             "</tr></thead>\n<tbody>\n";
     for (const CompareReportRow& row : rows) {
-        const std::string rowVerdict(toString(row.result->verdict));
+        const CompareVerdict v = rowVerdictOf(row);
+        const std::string rowVerdict(toString(v));
         html << "<tr class=\"comparison " << rowVerdict << "\" data-verdict=\"" << rowVerdict << "\" data-reference=\""
              << htmlEscape(row.referencePath) << "\">\n";
-        html << "<td>" << imageTag("reference", *row.reference, "reference " + row.referencePath)
+        html << "<td>" << imageCell("reference", row.reference, "reference " + row.referencePath)
              << "<div class=\"caption\">" << htmlEscape(row.referencePath) << "</div></td>\n";
-        html << "<td>" << imageTag("candidate", *row.candidate, "candidate " + row.candidatePath)
+        html << "<td>" << imageCell("candidate", row.candidate, "candidate " + row.candidatePath)
              << "<div class=\"caption\">" << htmlEscape(row.candidatePath)
              << "</div><div class=\"caption showing\">showing: candidate</div></td>\n";
         html << "<td>";
-        if (row.result->diffImage.empty()) html << "<div class=\"caption\">no diff: " << htmlEscape(row.result->mismatch) << "</div>";
-        else html << imageTag("diff", row.result->diffImage, "diff") << "<div class=\"caption\">diff</div>";
+        const Image* diff = row.result ? &row.result->diffImage : row.envelope ? &row.envelope->heatMap : nullptr;
+        const std::string mismatch = row.result ? row.result->mismatch : row.envelope ? row.envelope->mismatch : row.missing;
+        if (!diff || diff->empty()) html << "<div class=\"caption\">no diff: " << htmlEscape(mismatch) << "</div>";
+        else html << imageTag("diff", *diff, "diff") << "<div class=\"caption\">" << (row.envelope ? "envelope heat map" : "diff") << "</div>";
         html << "</td>\n";
+        const std::string numbers = row.result ? row.result->describe() : row.envelope ? row.envelope->describe() : row.missing;
         html << "<td><span class=\"badge row-verdict " << rowVerdict << "\">" << rowVerdict << "</span>"
-             << (row.matched ? (row.result->verdict == CompareVerdict::Pass ? " <span class=\"matched\">matched</span>"
-                                                                             : " <span class=\"matched\">best match</span>")
+             << (row.matched ? (v == CompareVerdict::Pass ? " <span class=\"matched\">matched</span>"
+                                                          : " <span class=\"matched\">best match</span>")
                              : "")
-             << "<pre>"
-             << htmlEscape(row.result->describe()) << "</pre></td>\n</tr>\n";
+             << "<pre>" << htmlEscape(numbers) << "</pre></td>\n</tr>\n";
     }
     html << "</tbody>\n</table>\n<script>" << kScript << "</script>\n</body>\n</html>\n";
 

@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 
 #include "core/compare.h"
+#include "core/envelope.h"
 #include "core/image.h"
 
 namespace refray::tools {
@@ -31,6 +32,14 @@ struct CompareCommandOptions {
     double pixelsPerDegree = kFlipDefaultPixelsPerDegree;
     bool golden = false;
     CompareThresholds thresholds;
+
+    // --golden DIR-or-envelope.exr: an envelope golden (docs/compare.md, "Envelope goldens"); a plain image there
+    // is the reference of the threshold comparison under --golden's profile (the older form).
+    std::string goldenPath;
+    // --golden-set DIR CANDIDATES_DIR: every golden of DIR's manifest against CANDIDATES_DIR/<name>.exr or .png.
+    std::string goldenSet;
+    std::string junitPath;  // --junit: JUnit XML of the --golden-set verdicts
+    EnvelopeJudgeOptions envelope;
 
     // --statistical: REFERENCE and CANDIDATE are statistics images (mean and variance).
     bool statistical = false;
@@ -57,6 +66,10 @@ struct CompareReportRow {
     const Image* candidate = nullptr;
     const CompareResult* result = nullptr;
     bool matched = false;  // the row the overall verdict comes from
+    // Instead of `result`: an envelope judgement (reference: the nominal image, diff: its heat map), or, with
+    // neither, `missing` says why there is no candidate (a failing row).
+    const EnvelopeJudgement* envelope = nullptr;
+    std::string missing;
 };
 
 // Writes one self-contained HTML page (images inline as PNG data URIs): a row per

@@ -480,9 +480,13 @@ int main(int argc, char** argv) {
 
     auto* golden = app.add_subcommand("golden", "Golden images of every scene x camera (tests/golden/)");
     golden->require_subcommand(1);
-    auto* update = golden->add_subcommand("update", "Re-render every golden, its order mask and the manifest");
+    auto* update = golden->add_subcommand("update", "Re-render the envelope golden of every scene x camera and the "
+                                                    "manifest (docs/golden-format.md)");
     std::string goldenDir = "tests/golden", goldenSize = "320x180", repositoryRoot = ".";
-    uint32_t goldenOrders = 4, goldenThreads = 0;
+    uint32_t goldenOrders = 4, goldenThreads = 0, goldenPerturbed = scenes::kDefaultPerturbedRenders;
+    update->add_option("--perturbed", goldenPerturbed, "Perturbed renders per golden (K: seeds 1..K)")
+        ->check(tools::wholeNumber("a number of perturbed renders"))
+        ->capture_default_str();
     update->add_option("--dir", goldenDir, "Where the goldens go")->capture_default_str();
     update->add_option("--root", repositoryRoot, "The repository root (holds scenes/)")->capture_default_str();
     update->add_option("--size", goldenSize, "Golden size WIDTHxHEIGHT")->capture_default_str();
@@ -493,8 +497,52 @@ int main(int argc, char** argv) {
         ->check(tools::threadCount())
         ->capture_default_str();
 
+    auto* make = golden->add_subcommand("make", "Render the envelope golden of one scene, camera, time and size into a "
+                                                "golden directory");
+    std::string makeScene, makeCamera, makeTime, makeSize = "320x180", makeDir;
+    uint32_t makeOrders = 4, makePerturbed = scenes::kDefaultPerturbedRenders, makeThreads = 0;
+    make->add_option("scene", makeScene, "Scene file")->required();
+    make->add_option("--camera", makeCamera, "Camera (default: the scene's first)");
+    make->add_option("--time", makeTime, "Time in seconds (default: the scene's)");
+    make->add_option("--size", makeSize, "WIDTHxHEIGHT")->capture_default_str();
+    make->add_option("-o,--dir", makeDir, "The golden directory (goldens.json is created or extended)")->required();
+    make->add_option("--root", repositoryRoot, "The repository root: scene paths in the manifest are relative to it")
+        ->capture_default_str();
+    make->add_option("--order-check", makeOrders, "Adversarial orders")
+        ->check(tools::wholeNumber("a number of adversarial orders"))
+        ->capture_default_str();
+    make->add_option("--perturbed", makePerturbed, "Perturbed renders (K: seeds 1..K)")
+        ->check(tools::wholeNumber("a number of perturbed renders"))
+        ->capture_default_str();
+    make->add_option("--threads", makeThreads, "Worker threads (0: all)")->check(tools::threadCount());
+    const auto printRender = [](const std::string& what, double seconds) {
+        std::printf("    %-28s %7.2f s\n", what.c_str(), seconds);
+        std::fflush(stdout);
+    };
+
     try {
         app.parse(argc, argv);
+        if (*make) {
+            const Size size = parseSize(makeSize);
+            scenes::GoldenMakeOptions options;
+            options.sceneFile = makeScene;
+            options.repositoryRoot = repositoryRoot;
+            options.goldenDirectory = makeDir;
+            options.camera = makeCamera;
+            options.time = makeTime;
+            options.width = size.width;
+            options.height = size.height;
+            options.orders = makeOrders;
+            options.perturbedRenders = makePerturbed;
+            options.refrayCommit = refray::tools::kCommit;
+            options.render.threads = makeThreads;
+            options.render.onRender = printRender;
+            const scenes::GoldenEntry e = scenes::makeGolden(options);
+            std::printf("wrote %s/%s (%llu sensitive, %llu order-dependent pixels) and %s/goldens.json\n",
+                        makeDir.c_str(), e.envelope.c_str(), (unsigned long long)e.sensitivePixels,
+                        (unsigned long long)e.orderDependentPixels, makeDir.c_str());
+            return 0;
+        }
         if (*render) return runRender(ro);
         if (*compare) return refray::tools::runCompare(compareOptions);
         if (*table) return refray::tools::runTable(tableOptions);
@@ -509,10 +557,13 @@ int main(int argc, char** argv) {
             options.height = size.height;
             options.orders = goldenOrders;
             options.threads = goldenThreads;
+            options.perturbedRenders = goldenPerturbed;
             options.refrayCommit = refray::tools::kCommit;
+            options.onRender = printRender;
             options.onEntry = [](const scenes::GoldenEntry& e, double seconds) {
-                std::printf("%-48s %ux%u  %6.2f s  %llu order-dependent pixels\n", e.name.c_str(), e.width, e.height,
-                            seconds, (unsigned long long)e.orderDependentPixels);
+                std::printf("%-48s %ux%u  %6.2f s  %llu sensitive, %llu order-dependent pixels\n", e.name.c_str(),
+                            e.width, e.height, seconds, (unsigned long long)e.sensitivePixels,
+                            (unsigned long long)e.orderDependentPixels);
                 std::fflush(stdout);
             };
             const scenes::GoldenSet set = scenes::updateGoldens(options);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -31,37 +32,9 @@ std::string jsonString(const std::string& s) {
     return out + "\"";
 }
 
-}  // namespace
-
-GoldenSet readGoldenManifest(const fs::path& manifest) {
-    const json::Value root = json::parseFile(manifest);
-    json::ObjectReader top(root, "the golden manifest");
-    const json::Value& format = top.required("format");
-    if (format.asString() != kGoldenFormat) format.fail("expected format '" + std::string(kGoldenFormat) + "'");
-    top.optional("comment");
-    GoldenSet set;
-    for (const json::Value& v : top.required("goldens").asArray()) {
-        json::ObjectReader r(v, "a golden entry");
-        GoldenEntry e;
-        e.name = r.required("name").asString();
-        e.scene = r.required("scene").asString();
-        e.sceneSha256 = r.required("sceneSha256").asString();
-        e.camera = r.required("camera").asString();
-        e.time = r.required("time").asString();
-        e.precision = r.required("precision").asString();
-        e.spp = r.required("spp").asUint32();
-        e.width = r.required("width").asUint32();
-        e.height = r.required("height").asUint32();
-        e.image = r.required("image").asString();
-        e.mask = r.required("mask").asString();
-        e.orders = r.required("orderCheckOrders").asUint32();
-        e.orderDependentPixels = uint64_t(r.required("orderDependentPixels").asInt());
-        e.refrayCommit = r.required("refrayCommit").asString();
-        r.finish();
-        set.entries.push_back(std::move(e));
-    }
-    if (const json::Value* statistical = top.optional("statistical"))
-        for (const json::Value& v : statistical->asArray()) {
+std::vector<StatisticalGoldenEntry> parseStatistical(const json::Value& array) {
+    std::vector<StatisticalGoldenEntry> entries;
+    for (const json::Value& v : array.asArray()) {
             json::ObjectReader r(v, "a statistical golden entry");
             StatisticalGoldenEntry e;
             e.name = r.required("name").asString();
@@ -77,8 +50,55 @@ GoldenSet readGoldenManifest(const fs::path& manifest) {
             e.refrayCommit = r.required("refrayCommit").asString();
             r.finish();
             if (e.batches < 2) v.fail("a statistical golden needs at least 2 batches");
-            set.statistical.push_back(std::move(e));
+            entries.push_back(std::move(e));
         }
+    return entries;
+}
+
+// The statistical entries of a manifest of any format (an update converts an older one).
+std::vector<StatisticalGoldenEntry> readStatisticalEntries(const fs::path& manifest) {
+    const json::Value root = json::parseFile(manifest);
+    json::ObjectReader top(root, "the golden manifest");
+    const json::Value* statistical = top.optional("statistical");
+    return statistical ? parseStatistical(*statistical) : std::vector<StatisticalGoldenEntry>{};
+}
+
+}  // namespace
+
+GoldenSet readGoldenManifest(const fs::path& manifest) {
+    const json::Value root = json::parseFile(manifest);
+    json::ObjectReader top(root, "the golden manifest");
+    const json::Value& format = top.required("format");
+    REFRAY_CHECK(format.asString() == kGoldenFormat,
+                 manifest.string() << " is a golden directory of format '" << format.asString() << "'; this refray reads '"
+                                   << kGoldenFormat
+                                   << "' (envelope goldens, docs/golden-format.md): remake it with 'refray golden "
+                                      "update' (or 'refray golden make')");
+    top.optional("comment");
+    GoldenSet set;
+    for (const json::Value& v : top.required("goldens").asArray()) {
+        json::ObjectReader r(v, "a golden entry");
+        GoldenEntry e;
+        e.name = r.required("name").asString();
+        e.scene = r.required("scene").asString();
+        e.sceneSha256 = r.required("sceneSha256").asString();
+        e.camera = r.required("camera").asString();
+        e.time = r.required("time").asString();
+        e.precision = r.required("precision").asString();
+        e.spp = r.required("spp").asUint32();
+        e.width = r.required("width").asUint32();
+        e.height = r.required("height").asUint32();
+        e.envelope = r.required("envelope").asString();
+        e.orders = r.required("orderCheckOrders").asUint32();
+        e.orderDependentPixels = uint64_t(r.required("orderDependentPixels").asInt());
+        e.perturbedRenders = r.required("perturbedRenders").asUint32();
+        e.sensitivePixels = uint64_t(r.required("sensitivePixels").asInt());
+        e.variationModel = r.required("variationModel").asString();
+        e.refrayCommit = r.required("refrayCommit").asString();
+        r.finish();
+        set.entries.push_back(std::move(e));
+    }
+    if (const json::Value* statistical = top.optional("statistical")) set.statistical = parseStatistical(*statistical);
     top.finish();
     return set;
 }
@@ -93,9 +113,10 @@ void writeGoldenManifest(const fs::path& manifest, const GoldenSet& set) {
             << ", \"sceneSha256\": " << jsonString(e.sceneSha256) << ",\n     \"camera\": " << jsonString(e.camera)
             << ", \"time\": " << jsonString(e.time) << ", \"precision\": " << jsonString(e.precision)
             << ", \"spp\": " << e.spp << ", \"width\": " << e.width << ", \"height\": " << e.height
-            << ",\n     \"image\": " << jsonString(e.image) << ", \"mask\": " << jsonString(e.mask)
-            << ", \"orderCheckOrders\": " << e.orders << ", \"orderDependentPixels\": " << e.orderDependentPixels
-            << ", \"refrayCommit\": " << jsonString(e.refrayCommit) << "}";
+            << ",\n     \"envelope\": " << jsonString(e.envelope) << ", \"perturbedRenders\": " << e.perturbedRenders
+            << ", \"variationModel\": " << jsonString(e.variationModel)
+            << ", \"sensitivePixels\": " << e.sensitivePixels << ",\n     \"orderCheckOrders\": " << e.orders
+            << ", \"orderDependentPixels\": " << e.orderDependentPixels << ", \"refrayCommit\": " << jsonString(e.refrayCommit) << "}";
     }
     out << "\n  ]";
     if (!set.statistical.empty()) {
@@ -162,6 +183,166 @@ StatisticsImage renderStatistics(Scene& scene, const StatisticalGoldenEntry& ent
     return stats;
 }
 
+procedural::Perturbation goldenPerturbation(uint32_t seed) {
+    procedural::Perturbation p;
+    p.seed = seed;
+    constexpr procedural::Contraction kCycle[] = {procedural::Contraction::Mixed, procedural::Contraction::Split,
+                                                  procedural::Contraction::Fuse};
+    p.contraction = kCycle[(seed + 2) % 3];
+    p.denormals = seed % 2 == 0 ? procedural::Denormals::Preserve : procedural::Denormals::Flush;
+    return p;
+}
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::string fixed(double seconds) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.2f", seconds);
+    return buf;
+}
+
+}  // namespace
+
+Envelope renderEnvelope(Scene& scene, GoldenEntry& entry, const EnvelopeRenderOptions& options) {
+    const RenderSettings base = goldenSettings(entry, options.threads);
+    const auto report = [&](const std::string& what, double seconds) {
+        if (options.onRender) options.onRender(what, seconds);
+    };
+    std::vector<Image> variants;
+    std::string perturbations;
+    double perturbedSeconds = 0.0;
+
+    // The nominal render and the order check (its adversarial orders are variants too).
+    auto start = std::chrono::steady_clock::now();
+    OrderCheckResult check = checkTraversalOrder(scene, base, 0);
+    const double nominalSeconds = secondsSince(start);
+    report("nominal", nominalSeconds);
+    start = std::chrono::steady_clock::now();
+    {
+        RenderSettings s = base;
+        s.order = dxr::TraversalOrder::Adversarial;
+        Image mask(entry.width, entry.height, vec4(0.0f, 0.0f, 0.0f, 1.0f));
+        for (uint32_t seed = 1; seed <= entry.orders; ++seed) {
+            s.adversarialSeed = seed;
+            Image other = scene.render(s).image;
+            for (size_t i = 0; i < other.pixels().size(); ++i)
+                if (std::memcmp(&other.pixels()[i], &check.ordered.image.pixels()[i], sizeof(vec4)) != 0)
+                    mask.pixels()[i] = vec4(1.0f);
+            variants.push_back(std::move(other));
+        }
+        check.mask = std::move(mask);
+    }
+    const double orderSeconds = secondsSince(start);
+    if (entry.orders) report(std::to_string(entry.orders) + " adversarial orders", orderSeconds);
+
+    // K legal GPUs of the variation model, then double precision.
+    for (uint32_t seed = 1; seed <= entry.perturbedRenders; ++seed) {
+        start = std::chrono::steady_clock::now();
+        RenderSettings s = base;
+        s.perturbation = goldenPerturbation(seed);
+        variants.push_back(scene.render(s).image);
+        perturbations += (perturbations.empty() ? "" : "; ") + procedural::describe(*s.perturbation);
+        const double seconds = secondsSince(start);
+        perturbedSeconds += seconds;
+        report("perturbed seed " + std::to_string(seed), seconds);
+    }
+    start = std::chrono::steady_clock::now();
+    {
+        RenderSettings s = base;
+        s.precision = procedural::Precision::Double;
+        variants.push_back(scene.render(s).image);
+    }
+    const double doubleSeconds = secondsSince(start);
+    report("double", doubleSeconds);
+
+    // makeEnvelope counts the first `perturbedRenders` variants as the exchangeable ones; order them so.
+    std::vector<const Image*> pointers;
+    for (size_t i = entry.orders; i < entry.orders + entry.perturbedRenders; ++i) pointers.push_back(&variants[i]);
+    for (size_t i = 0; i < entry.orders; ++i) pointers.push_back(&variants[i]);
+    pointers.push_back(&variants.back());
+    Envelope envelope = makeEnvelope(check.ordered.image, pointers, entry.perturbedRenders, &check.mask);
+
+    entry.orderDependentPixels = 0;
+    for (uint8_t o : envelope.orderDependent) entry.orderDependentPixels += o;
+    entry.sensitivePixels = envelope.sensitivePixels();
+    entry.variationModel = std::string(procedural::kVariationModel);
+    auto& p = envelope.provenance;
+    p["golden_name"] = entry.name;
+    p["scene"] = entry.scene;
+    p["scene_sha256"] = entry.sceneSha256;
+    p["camera"] = entry.camera;
+    p["time"] = entry.time;
+    p["precision"] = entry.precision;
+    p["size"] = std::to_string(entry.width) + "x" + std::to_string(entry.height);
+    p["refray_commit"] = entry.refrayCommit;
+    p["variation_model"] = entry.variationModel;
+    p["perturbed_seeds"] = entry.perturbedRenders ? "1.." + std::to_string(entry.perturbedRenders) : "none";
+    p["perturbations"] = perturbations;
+    p["order_check_orders"] = std::to_string(entry.orders);
+    p["order_dependent_pixels"] = std::to_string(entry.orderDependentPixels);
+    p["sensitive_pixels"] = std::to_string(entry.sensitivePixels);
+    p["other_variants"] = "precision double; adversarial orders 1.." + std::to_string(entry.orders);
+    p["render_seconds_nominal"] = fixed(nominalSeconds);
+    p["render_seconds_perturbed"] = fixed(perturbedSeconds);
+    p["render_seconds_double"] = fixed(doubleSeconds);
+    p["render_seconds_orders"] = fixed(orderSeconds);
+    // The nominal render's own metadata (scene, camera, ...) stays on the nominal; the envelope's keys win.
+    for (const auto& [key, value] : check.ordered.image.metadata) p.try_emplace(key, value);
+    envelope.nominal.metadata.clear();
+    return envelope;
+}
+
+namespace {
+
+GoldenEntry entryFor(const SceneDesc& desc, const fs::path& file, const fs::path& root, const CameraDesc& camera,
+                     const std::string& time, uint32_t width, uint32_t height, uint32_t orders, uint32_t perturbed,
+                     const std::string& commit) {
+    GoldenEntry e;
+    e.name = desc.name + "." + camera.name;
+    std::error_code ec;
+    const fs::path relative = fs::relative(file, root, ec);
+    e.scene = (!ec && !relative.empty() && *relative.begin() != "..") ? relative.generic_string()
+                                                                        : fs::absolute(file).generic_string();
+    e.sceneSha256 = desc.fileHash;
+    e.camera = camera.name;
+    e.time = time.empty() ? desc.defaultTimeText : time;
+    e.width = width;
+    e.height = height;
+    e.envelope = e.name + ".envelope.exr";
+    e.orders = orders;
+    e.perturbedRenders = perturbed;
+    e.refrayCommit = commit;
+    return e;
+}
+
+}  // namespace
+
+GoldenEntry makeGolden(const GoldenMakeOptions& options) {
+    Scene scene(loadSceneFile(options.sceneFile));
+    const SceneDesc& desc = scene.desc();
+    REFRAY_CHECK(!isMonteCarlo(desc), options.sceneFile.string()
+                                          << " is a Monte Carlo scene: it gets a statistical golden (docs/compare.md), "
+                                             "not an envelope");
+    const CameraDesc& camera = options.camera.empty() ? desc.cameras.at(0) : desc.camera(options.camera);
+    GoldenEntry e = entryFor(desc, options.sceneFile, options.repositoryRoot, camera, options.time, options.width,
+                             options.height, options.orders, options.perturbedRenders, options.refrayCommit);
+    fs::create_directories(options.goldenDirectory);
+    const Envelope envelope = renderEnvelope(scene, e, options.render);
+    writeEnvelope((options.goldenDirectory / e.envelope).string(), envelope);
+
+    const fs::path manifest = options.goldenDirectory / "goldens.json";
+    GoldenSet set;
+    if (fs::exists(manifest)) set = readGoldenManifest(manifest);
+    std::erase_if(set.entries, [&](const GoldenEntry& other) { return other.name == e.name; });
+    set.entries.push_back(e);
+    writeGoldenManifest(manifest, set);
+    return e;
+}
+
 GoldenSet updateGoldens(const GoldenUpdateOptions& options) {
     std::vector<fs::path> files;
     for (const auto& f : fs::directory_iterator(options.repositoryRoot / "scenes"))
@@ -172,34 +353,32 @@ GoldenSet updateGoldens(const GoldenUpdateOptions& options) {
 
     GoldenSet set;
     const fs::path manifest = options.goldenDirectory / "goldens.json";
-    if (fs::exists(manifest)) set.statistical = readGoldenManifest(manifest).statistical;
+    if (fs::exists(manifest)) {
+        // The statistical entries are kept; an older manifest's are read by hand so that an update converts it.
+        try {
+            set.statistical = readGoldenManifest(manifest).statistical;
+        } catch (const Error&) {
+            set.statistical = readStatisticalEntries(manifest);
+        }
+    }
     for (const fs::path& file : files) {
         Scene scene(loadSceneFile(file));
         const SceneDesc& desc = scene.desc();
         if (isMonteCarlo(desc)) continue;  // statistical goldens only (below)
         for (const CameraDesc& camera : desc.cameras) {
             const auto start = std::chrono::steady_clock::now();
-            GoldenEntry e;
-            e.name = desc.name + "." + camera.name;
-            e.scene = fs::relative(file, options.repositoryRoot).generic_string();
-            e.sceneSha256 = desc.fileHash;
-            e.camera = camera.name;
-            e.time = desc.defaultTimeText;
-            e.width = options.width;
-            e.height = options.height;
-            e.image = e.name + ".exr";
-            e.mask = orderMaskPath(e.image);
-            e.orders = options.orders;
-            e.refrayCommit = options.refrayCommit;
-            const OrderCheckResult check = checkTraversalOrder(scene, goldenSettings(e, options.threads), options.orders);
-            e.orderDependentPixels = check.orderDependentPixels;
-            Image image = check.ordered.image;
-            image.metadata["refray_commit"] = options.refrayCommit;
-            writeImage((options.goldenDirectory / e.image).string(), image);
-            writeImage((options.goldenDirectory / e.mask).string(), check.mask);
+            GoldenEntry e = entryFor(desc, file, options.repositoryRoot, camera, "", options.width, options.height,
+                                     options.orders, options.perturbedRenders, options.refrayCommit);
+            EnvelopeRenderOptions render;
+            render.threads = options.threads;
+            render.onRender = options.onRender;
+            const Envelope envelope = renderEnvelope(scene, e, render);
+            writeEnvelope((options.goldenDirectory / e.envelope).string(), envelope);
+            // The files of the older format (a plain golden and its order mask) are replaced by the envelope.
+            fs::remove(options.goldenDirectory / (e.name + ".exr"));
+            fs::remove(options.goldenDirectory / (e.name + ".order-mask.png"));
             set.entries.push_back(e);
-            if (options.onEntry)
-                options.onEntry(e, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+            if (options.onEntry) options.onEntry(e, secondsSince(start));
         }
     }
     for (StatisticalGoldenEntry& e : set.statistical) {

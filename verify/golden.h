@@ -1,6 +1,9 @@
-// The golden set: one EXR per scene file x camera at a small size, each with its order-dependence mask and the
-// settings that made it, listed in a manifest (tests/golden/goldens.json). `refray golden update` writes them; the
-// golden CTest re-renders each entry and compares with the shared comparator (core/compare.h).
+// The golden set: one envelope golden (core/envelope.h, docs/golden-format.md) per scene file x camera at a small
+// size, with the settings that made it, listed in a manifest (tests/golden/goldens.json). An envelope is made of the
+// nominal render, K perturbed renders (legal GPUs of the variation model, docs/numerical-variation.md), a
+// double-precision render and the adversarial traversal orders of the order check. `refray golden update` writes
+// them, `refray golden make` one of them for any scene and settings; the golden CTest re-renders each entry and
+// judges it against its envelope.
 #pragma once
 
 #include <cstdint>
@@ -9,13 +12,17 @@
 #include <string>
 #include <vector>
 
+#include "core/envelope.h"
 #include "core/statistical_compare.h"
 #include "verify/order_check.h"
 #include "scenes/scene.h"
 
 namespace refray::scenes {
 
-inline constexpr std::string_view kGoldenFormat = "refray-goldens/1";
+inline constexpr std::string_view kGoldenFormat = "refray-goldens/2";
+
+// The perturbed renders of an envelope golden: seeds 1..K, the default.
+inline constexpr uint32_t kDefaultPerturbedRenders = 8;
 
 struct GoldenEntry {
     std::string name;         // "<scene name>.<camera>"
@@ -26,12 +33,18 @@ struct GoldenEntry {
     std::string precision = "float";
     uint32_t spp = 1;
     uint32_t width = 0, height = 0;
-    std::string image;  // EXR, relative to the manifest
-    std::string mask;   // PNG, relative to the manifest
-    uint32_t orders = 0;  // adversarial orders of the order check
+    std::string envelope;  // the envelope EXR, relative to the manifest
+    uint32_t orders = 0;   // adversarial orders of the order check (seeds 1..orders)
     uint64_t orderDependentPixels = 0;
+    uint32_t perturbedRenders = kDefaultPerturbedRenders;  // K: seeds 1..K, see goldenPerturbation
+    uint64_t sensitivePixels = 0;
+    std::string variationModel;  // procedural::kVariationModel when made
     std::string refrayCommit;
 };
+
+// The legal GPU of perturbed render `seed` (1..K): the contraction cycles mixed, split, fuse and the denormals
+// alternate flush (odd seeds) and preserve (even seeds), so K >= 6 covers every combination.
+procedural::Perturbation goldenPerturbation(uint32_t seed);
 
 // A statistical golden (docs/compare.md, "The Cornell box golden"): for a scene whose shaders sample at random
 // (ShaderLibraryBinding::samplesInShader), a statistics image (core/statistical_compare.h) of `batches` renders with
@@ -54,6 +67,8 @@ struct GoldenSet {
     std::vector<StatisticalGoldenEntry> statistical;
 };
 
+// Throws refray::Error naming the file for a manifest of another format (an older refray's: "remake it with
+// 'refray golden update'") or a malformed one.
 GoldenSet readGoldenManifest(const std::filesystem::path& manifest);
 void writeGoldenManifest(const std::filesystem::path& manifest, const GoldenSet& set);
 
@@ -71,19 +86,49 @@ bool isMonteCarlo(const SceneDesc& scene);
 StatisticsImage renderStatistics(Scene& scene, const StatisticalGoldenEntry& entry, uint32_t firstSeed,
                                  uint32_t batches, uint32_t threads);
 
+struct EnvelopeRenderOptions {
+    uint32_t threads = 0;
+    // After each render: what it was ("nominal", "perturbed seed 3", "double", "order 2") and its seconds.
+    std::function<void(const std::string& what, double seconds)> onRender;
+};
+
+// Renders the envelope of a golden entry's settings: the nominal render, entry.perturbedRenders perturbed ones
+// (goldenPerturbation(1..K)), one with --precision double and entry.orders adversarial orders (the order mask); fills
+// entry.orderDependentPixels and entry.sensitivePixels; the provenance names the settings, seeds, commit, variation
+// model, scene SHA-256 and the seconds each kind of render took.
+Envelope renderEnvelope(Scene& scene, GoldenEntry& entry, const EnvelopeRenderOptions& options);
+
+// `refray golden make`: the envelope golden of one scene file, camera, time and size, written as
+// <directory>/<scene name>.<camera>.envelope.exr and added to (or replaced in) <directory>/goldens.json.
+struct GoldenMakeOptions {
+    std::filesystem::path sceneFile;
+    std::filesystem::path repositoryRoot = ".";  // the manifest names the scene relative to it where it lies inside
+    std::filesystem::path goldenDirectory;
+    std::string camera;  // empty: the scene's first camera
+    std::string time;    // empty: the scene's default time
+    uint32_t width = 320, height = 180;
+    uint32_t orders = 4;
+    uint32_t perturbedRenders = kDefaultPerturbedRenders;
+    std::string refrayCommit;
+    EnvelopeRenderOptions render;
+};
+GoldenEntry makeGolden(const GoldenMakeOptions& options);
+
 struct GoldenUpdateOptions {
     std::filesystem::path repositoryRoot;  // scene paths are relative to it
     std::filesystem::path goldenDirectory;
     uint32_t width = 320, height = 180;
     uint32_t orders = 4;
+    uint32_t perturbedRenders = kDefaultPerturbedRenders;
     uint32_t threads = 0;
     std::string refrayCommit;
+    std::function<void(const std::string& what, double seconds)> onRender;  // each render of each envelope
     std::function<void(const GoldenEntry&, double seconds)> onEntry;  // after each entry is written
     std::function<void(const StatisticalGoldenEntry&, double seconds)> onStatisticalEntry;
 };
 
-// Renders every top-level scenes/*.json x camera at the scene's default time, with an order check, writes
-// <name>.exr, <name>.order-mask.png and goldens.json into goldenDirectory, and returns the set. Monte Carlo scenes
+// Renders the envelope of every top-level scenes/*.json x camera at the scene's default time, writes
+// <name>.envelope.exr and goldens.json into goldenDirectory, and returns the set. Monte Carlo scenes
 // (isMonteCarlo) get no threshold golden: the statistical entries of the existing manifest are kept, each
 // re-rendered with its own settings (size, spp, batches, seed; `width`/`height` above do not apply).
 GoldenSet updateGoldens(const GoldenUpdateOptions& options);

@@ -1,0 +1,363 @@
+#include "core/envelope.h"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include <OpenImageIO/imageio.h>
+#include <boost/math/distributions/binomial.hpp>
+
+#include "core/error.h"
+
+namespace refray {
+
+namespace {
+
+constexpr const char* kMetadataPrefix = "refray:";
+constexpr const char* kFormatKey = "envelope_format";
+constexpr const char* kPerturbedKey = "envelope_perturbed_renders";
+constexpr const char* kVariantsKey = "envelope_variants";
+constexpr const char kChannelLetters[] = "RGB";
+const std::vector<std::string> kChannelNames = {"R",    "G",    "B",    "A",     "lo.R", "lo.G",
+                                                "lo.B", "hi.R", "hi.G", "hi.B",  "class", "order"};
+
+std::string sizeText(uint32_t w, uint32_t h) { return std::to_string(w) + "x" + std::to_string(h); }
+
+int code(float v) { return floatToUnorm8(v); }
+
+}  // namespace
+
+uint64_t Envelope::sensitivePixels() const {
+    return uint64_t(std::count(pixelClass.begin(), pixelClass.end(), PixelClass::Sensitive));
+}
+
+Envelope makeEnvelope(const Image& nominal, const std::vector<const Image*>& variants, uint32_t perturbedRenders,
+                      const Image* orderMask) {
+    REFRAY_CHECK(!nominal.empty(), "an envelope needs a nominal render");
+    REFRAY_CHECK(perturbedRenders <= variants.size(),
+                 perturbedRenders << " perturbed renders named but only " << variants.size() << " variants given");
+    const uint32_t w = nominal.width(), h = nominal.height();
+    for (const Image* v : variants)
+        REFRAY_CHECK(v && v->width() == w && v->height() == h,
+                     "a variant of " << (v ? sizeText(v->width(), v->height()) : "no image") << " for a nominal of "
+                                     << sizeText(w, h));
+    if (orderMask)
+        REFRAY_CHECK(orderMask->width() == w && orderMask->height() == h,
+                     "an order mask of " << sizeText(orderMask->width(), orderMask->height()) << " for a nominal of "
+                                         << sizeText(w, h));
+    Envelope e;
+    e.nominal = nominal;
+    e.perturbedRenders = perturbedRenders;
+    e.variants = uint32_t(variants.size()) + 1;
+    const size_t n = size_t(w) * h;
+    e.lo.resize(n);
+    e.hi.resize(n);
+    e.pixelClass.assign(n, PixelClass::Stable);
+    e.orderDependent.assign(n, 0);
+    for (size_t i = 0; i < n; ++i) {
+        for (int c = 0; c < kEnvelopeChannels; ++c) {
+            const int q = code(nominal.pixels()[i][c]);
+            int lo = q, hi = q;
+            for (const Image* v : variants) {
+                const int qv = code(v->pixels()[i][c]);
+                lo = std::min(lo, qv);
+                hi = std::max(hi, qv);
+            }
+            e.lo[i][c] = uint8_t(lo);
+            e.hi[i][c] = uint8_t(hi);
+            if (lo < q - 1 || hi > q + 1) e.pixelClass[i] = PixelClass::Sensitive;
+        }
+        if (orderMask) {
+            const vec4& m = orderMask->pixels()[i];
+            e.orderDependent[i] = (m.r != 0.0f || m.g != 0.0f || m.b != 0.0f) ? 1 : 0;
+        }
+    }
+    return e;
+}
+
+void writeEnvelope(const std::string& path, const Envelope& e) {
+    const size_t n = e.nominal.pixels().size();
+    REFRAY_CHECK(n > 0 && e.lo.size() == n && e.hi.size() == n && e.pixelClass.size() == n &&
+                     e.orderDependent.size() == n,
+                 "cannot write the envelope '" << path << "': its planes do not match its " << sizeText(e.width(), e.height())
+                                               << " nominal");
+    auto out = OIIO::ImageOutput::create(path);
+    REFRAY_CHECK(out, "cannot write '" << path << "': " << OIIO::geterror());
+    const int channels = int(kChannelNames.size());
+    OIIO::ImageSpec spec(int(e.width()), int(e.height()), channels, OIIO::TypeDesc::FLOAT);
+    spec.channelnames = kChannelNames;
+    spec.alpha_channel = 3;
+    for (const auto& [key, value] : e.nominal.metadata) spec.attribute(kMetadataPrefix + key, value);
+    for (const auto& [key, value] : e.provenance) spec.attribute(kMetadataPrefix + key, value);
+    spec.attribute(std::string(kMetadataPrefix) + kFormatKey, std::string(kEnvelopeFormat));
+    spec.attribute(std::string(kMetadataPrefix) + kPerturbedKey, std::to_string(e.perturbedRenders));
+    spec.attribute(std::string(kMetadataPrefix) + kVariantsKey, std::to_string(e.variants));
+    spec.attribute("compression", "zip");
+    spec.attribute("oiio:UnassociatedAlpha", 1);
+    REFRAY_CHECK(out->open(path, spec), "cannot open '" << path << "' for writing: " << out->geterror());
+    std::vector<float> data(n * channels);
+    for (size_t i = 0; i < n; ++i) {
+        float* p = &data[i * channels];
+        for (int c = 0; c < 4; ++c) p[c] = e.nominal.pixels()[i][c];
+        for (int c = 0; c < 3; ++c) {
+            p[4 + c] = float(e.lo[i][c]) / 255.0f;
+            p[7 + c] = float(e.hi[i][c]) / 255.0f;
+        }
+        p[10] = float(uint8_t(e.pixelClass[i]));
+        p[11] = float(e.orderDependent[i]);
+    }
+    REFRAY_CHECK(out->write_image(OIIO::TypeDesc::FLOAT, data.data()),
+                 "cannot write pixels to '" << path << "': " << out->geterror());
+    REFRAY_CHECK(out->close(), "cannot close '" << path << "': " << out->geterror());
+}
+
+namespace {
+
+std::unique_ptr<OIIO::ImageInput> openEnvelope(const std::string& path) {
+    REFRAY_CHECK(std::filesystem::exists(path), "cannot read the envelope '" << path << "': no such file");
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(path, &config);
+    REFRAY_CHECK(in, "cannot read the envelope '" << path << "' (corrupted or not an image): " << OIIO::geterror());
+    return in;
+}
+
+}  // namespace
+
+bool isEnvelopeFile(const std::string& path) {
+    if (std::filesystem::is_directory(path)) return false;
+    return openEnvelope(path)->spec().channelindex("lo.R") >= 0;
+}
+
+Envelope readEnvelope(const std::string& path) {
+    auto in = openEnvelope(path);
+    const OIIO::ImageSpec& spec = in->spec();
+    REFRAY_CHECK(spec.width > 0 && spec.height > 0, "the envelope '" << path << "' has no pixels");
+    int index[12];
+    for (size_t c = 0; c < kChannelNames.size(); ++c) index[c] = spec.channelindex(kChannelNames[c]);
+    REFRAY_CHECK(index[4] >= 0,
+                 "'" << path << "' is not an envelope golden (no lo.R channel): a plain image; compare it with "
+                                "'refray compare REFERENCE CANDIDATE', or make an envelope with 'refray golden make'");
+    std::map<std::string, std::string> metadata;
+    const std::string prefix = kMetadataPrefix;
+    for (const auto& attribute : spec.extra_attribs) {
+        const std::string name = attribute.name().string();
+        if (name.rfind(prefix, 0) == 0) metadata[name.substr(prefix.size())] = attribute.get_string();
+    }
+    const auto format = metadata.find(kFormatKey);
+    REFRAY_CHECK(format != metadata.end() && format->second == kEnvelopeFormat,
+                 "the envelope '" << path << "' is of format '"
+                                  << (format == metadata.end() ? std::string("none") : format->second)
+                                  << "', this refray reads '" << kEnvelopeFormat
+                                  << "'; remake it with 'refray golden update' or 'refray golden make'");
+    for (size_t c = 0; c < kChannelNames.size(); ++c)
+        REFRAY_CHECK(index[c] >= 0 || c == 3,
+                     "the envelope '" << path << "' is corrupted: it lacks the channel " << kChannelNames[c]);
+    Envelope e;
+    try {
+        e.perturbedRenders = uint32_t(std::stoul(metadata.at(kPerturbedKey)));
+        e.variants = uint32_t(std::stoul(metadata.at(kVariantsKey)));
+    } catch (const std::exception&) {
+        REFRAY_CHECK(false, "the envelope '" << path << "' is corrupted: no readable refray:" << kPerturbedKey << " or refray:"
+                                     << kVariantsKey);
+    }
+    const int channels = spec.nchannels;
+    const size_t n = size_t(spec.width) * spec.height;
+    std::vector<float> data(n * channels);
+    REFRAY_CHECK(in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, data.data()),
+                 "the envelope '" << path << "' is corrupted: cannot read its pixels: " << in->geterror());
+    e.nominal = Image(uint32_t(spec.width), uint32_t(spec.height));
+    e.lo.resize(n);
+    e.hi.resize(n);
+    e.pixelClass.resize(n);
+    e.orderDependent.resize(n);
+    for (const auto& [key, value] : metadata)
+        if (key != kFormatKey && key != kPerturbedKey && key != kVariantsKey) e.provenance[key] = value;
+    const auto fail = [&](size_t i, const std::string& what) {
+        REFRAY_CHECK(false, "the envelope '" << path << "' is corrupted at (" << i % uint32_t(spec.width) << ", "
+                                     << i / uint32_t(spec.width) << "): " << what);
+    };
+    const auto asCode = [&](size_t i, float v, const std::string& channel) {
+        const float scaled = v * 255.0f;
+        if (!(scaled >= 0.0f && scaled <= 255.0f) || std::fabs(scaled - std::round(scaled)) > 1e-3f)
+            fail(i, channel + " = " + std::to_string(v) + " is no UNORM8 value (code/255)");
+        return int(std::lround(scaled));
+    };
+    for (size_t i = 0; i < n; ++i) {
+        const float* p = &data[i * channels];
+        e.nominal.pixels()[i] = vec4(p[index[0]], p[index[1]], p[index[2]], index[3] >= 0 ? p[index[3]] : 1.0f);
+        for (int c = 0; c < 3; ++c) {
+            const int lo = asCode(i, p[index[4 + c]], kChannelNames[4 + c]);
+            const int hi = asCode(i, p[index[7 + c]], kChannelNames[7 + c]);
+            const int q = code(e.nominal.pixels()[i][c]);
+            if (!(lo <= q && q <= hi))
+                fail(i, "the nominal " + std::string(1, kChannelLetters[c]) + " (code " + std::to_string(q) +
+                            ") lies outside its bounds [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+            e.lo[i][c] = uint8_t(lo);
+            e.hi[i][c] = uint8_t(hi);
+        }
+        const float cls = p[index[10]], order = p[index[11]];
+        if (cls != 0.0f && cls != 1.0f) fail(i, "class = " + std::to_string(cls) + " (0 stable, 1 sensitive)");
+        if (order != 0.0f && order != 1.0f) fail(i, "order = " + std::to_string(order) + " (0 or 1)");
+        e.pixelClass[i] = cls == 1.0f ? PixelClass::Sensitive : PixelClass::Stable;
+        e.orderDependent[i] = order == 1.0f ? 1 : 0;
+    }
+    e.nominal.metadata = e.provenance;
+    return e;
+}
+
+EnvelopeJudgement judgeEnvelope(const Envelope& e, const Image& candidate, const EnvelopeJudgeOptions& options) {
+    REFRAY_CHECK(options.falseAlarm > 0.0 && options.falseAlarm < 1.0,
+                 "the false-alarm probability must lie in (0, 1), not " << options.falseAlarm);
+    REFRAY_CHECK(options.clusterSize >= 1, "the cluster size must be at least 1");
+    EnvelopeJudgement j;
+    j.width = e.width();
+    j.height = e.height();
+    j.perturbedRenders = e.perturbedRenders;
+    if (candidate.width() != e.width() || candidate.height() != e.height()) {
+        j.verdict = CompareVerdict::Mismatch;
+        j.mismatch = "the candidate is " + sizeText(candidate.width(), candidate.height()) + ", the golden " +
+                     sizeText(e.width(), e.height());
+        return j;
+    }
+    const size_t n = size_t(e.width()) * e.height();
+    j.pixels = n;
+    j.heatMap = Image(e.width(), e.height(), vec4(0.0f, 0.0f, 0.0f, 1.0f));
+    for (size_t i = 0; i < n; ++i) {
+        const vec4& cv = candidate.pixels()[i];
+        const vec4& nv = e.nominal.pixels()[i];
+        const bool order = e.orderDependent[i] != 0;
+        const bool sensitive = e.pixelClass[i] == PixelClass::Sensitive;
+        if (order) ++j.orderPixels;
+        else if (sensitive) ++j.sensitivePixels;
+        else ++j.stablePixels;
+        const float grey = 0.2f * (0.2126f * std::clamp(nv.r, 0.0f, 1.0f) + 0.7152f * std::clamp(nv.g, 0.0f, 1.0f) +
+                                   0.0722f * std::clamp(nv.b, 0.0f, 1.0f));
+        j.heatMap.pixels()[i] = vec4(grey, grey, grey, 1.0f);
+
+        EnvelopePixel px;
+        px.x = uint32_t(i % e.width());
+        px.y = uint32_t(i / e.width());
+        px.pixelClass = e.pixelClass[i];
+        px.orderDependent = order;
+        for (int c = 0; c < kEnvelopeChannels; ++c) {
+            if (!std::isfinite(cv[c])) {
+                px.nonFinite = true;
+                px.channel = c;
+                px.steps = INT_MAX;
+                break;
+            }
+            const int q = code(cv[c]), qn = code(nv[c]);
+            const int lo = sensitive ? int(e.lo[i][c]) - 1 : qn - 1;
+            const int hi = sensitive ? int(e.hi[i][c]) + 1 : qn + 1;
+            const int steps = q < lo ? lo - q : q > hi ? q - hi : 0;
+            if (steps > px.steps) {
+                px.steps = steps;
+                px.channel = c;
+                px.candidate = q;
+                px.allowedLo = std::max(lo, 0);
+                px.allowedHi = std::min(hi, 255);
+            }
+        }
+        if (px.steps == 0) continue;
+        j.maxSteps = std::max(j.maxSteps, px.steps);
+        if (px.nonFinite) {
+            ++j.nonFinite;
+            j.heatMap.pixels()[i] = vec4(1.0f, 0.0f, 1.0f, 1.0f);
+        } else if (order) {
+            ++j.orderOutside;
+            j.heatMap.pixels()[i] = vec4(0.2f, 0.4f, 1.0f, 1.0f);
+        } else if (sensitive) {
+            ++j.sensitiveOutside;
+            const float t = std::min(1.0f, float(px.steps) / 32.0f);
+            j.heatMap.pixels()[i] = vec4(1.0f, 0.55f + 0.45f * t, 0.1f + 0.5f * t, 1.0f);
+        } else {
+            ++j.stableOutside;
+            j.heatMap.pixels()[i] = vec4(1.0f, 0.0f, 0.0f, 1.0f);
+        }
+        j.outside.push_back(px);
+    }
+
+    // The count test: a correct candidate exchangeable with the K perturbed renders falls outside their [min, max]
+    // with probability at most 2/(K+1) per pixel; clusters of `clusterSize` pixels move together.
+    const uint32_t k = std::max<uint32_t>(e.perturbedRenders, 1);
+    j.outsideProbability = std::min(1.0, 2.0 / double(k + 1));
+    j.expectedOutside = double(j.sensitivePixels) * j.outsideProbability;
+    if (j.sensitivePixels > 0) {
+        const double clusters = std::ceil(double(j.sensitivePixels) / options.clusterSize);
+        if (j.outsideProbability >= 1.0) {
+            j.sensitiveBudget = j.sensitivePixels;
+        } else {
+            const boost::math::binomial_distribution<double> binomial(clusters, j.outsideProbability);
+            const double q = std::ceil(boost::math::quantile(boost::math::complement(binomial, options.falseAlarm)));
+            j.sensitiveBudget = std::min<uint64_t>(j.sensitivePixels, uint64_t(q) * options.clusterSize);
+        }
+    }
+    if (j.nonFinite > 0 || j.stableOutside > 0 || j.sensitiveOutside > j.sensitiveBudget)
+        j.verdict = CompareVerdict::Fail;
+    else if (double(j.sensitiveOutside) > j.expectedOutside)
+        j.verdict = CompareVerdict::Warn;
+    return j;
+}
+
+std::string EnvelopeJudgement::describe(size_t listed) const {
+    std::ostringstream out;
+    if (verdict == CompareVerdict::Mismatch) {
+        out << "  verdict         MISMATCH (" << mismatch << ")\n";
+        return out.str();
+    }
+    const auto pct = [&](uint64_t a, uint64_t b) {
+        std::ostringstream s;
+        s << a << " (" << (b ? 100.0 * double(a) / double(b) : 0.0) << "%)";
+        return s.str();
+    };
+    out << "  size            " << width << "x" << height << ", RGB judged in UNORM8 steps (1/255)\n";
+    out << "  pixels          " << stablePixels << " stable, " << sensitivePixels << " sensitive, " << orderPixels
+        << " order-dependent (reported apart)\n";
+    out << "  stable outside  " << pct(stableOutside, stablePixels)
+        << " beyond one step of the nominal (allowed: 0)\n";
+    out << "  sensitive out   " << pct(sensitiveOutside, sensitivePixels)
+        << " beyond one step outside the envelope (expected at most " << expectedOutside << " = "
+        << sensitivePixels << " x 2/(K+1), K = " << perturbedRenders << "; allowed: " << sensitiveBudget << ")\n";
+    if (orderPixels) out << "  order outside   " << orderOutside << " of " << orderPixels << " (not in the verdict)\n";
+    if (nonFinite) out << "  non-finite      " << nonFinite << " pixels hold NaN or infinity (always a failure)\n";
+    if (!outside.empty()) {
+        out << "  largest         " << (maxSteps == INT_MAX ? std::string("NaN/inf") : std::to_string(maxSteps) + " steps")
+            << " outside\n";
+        // The worst first, then scan order.
+        std::vector<EnvelopePixel> worst = outside;
+        std::stable_sort(worst.begin(), worst.end(), [](const EnvelopePixel& a, const EnvelopePixel& b) {
+            const auto rank = [](const EnvelopePixel& p) {
+                return p.nonFinite ? 3 : p.orderDependent ? 0 : p.pixelClass == PixelClass::Stable ? 2 : 1;
+            };
+            return rank(a) != rank(b) ? rank(a) > rank(b) : a.steps > b.steps;
+        });
+        for (size_t i = 0; i < std::min(listed, worst.size()); ++i) {
+            const EnvelopePixel& p = worst[i];
+            out << "    (" << p.x << ", " << p.y << ") "
+                << (p.orderDependent ? "order" : p.pixelClass == PixelClass::Stable ? "stable" : "sensitive") << " "
+                << kChannelLetters[p.channel] << ": ";
+            if (p.nonFinite) out << "NaN or infinity\n";
+            else
+                out << "code " << p.candidate << ", allowed " << p.allowedLo << ".." << p.allowedHi << ", " << p.steps
+                    << " steps outside\n";
+        }
+        if (worst.size() > listed) out << "    ... and " << worst.size() - listed << " more\n";
+    }
+    out << "  verdict         " << toString(verdict);
+    if (verdict == CompareVerdict::Fail) {
+        out << " (";
+        if (nonFinite) out << "NaN or infinity; ";
+        if (stableOutside) out << stableOutside << " stable pixels moved; ";
+        if (sensitiveOutside > sensitiveBudget)
+            out << sensitiveOutside << " sensitive pixels outside, more than " << sensitiveBudget << " allowed; ";
+        out.seekp(-2, std::ios_base::cur);
+        out << ")";
+    }
+    out << "\n";
+    return out.str();
+}
+
+}  // namespace refray

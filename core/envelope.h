@@ -1,0 +1,99 @@
+// Envelope goldens (issue 17, docs/golden-format.md): what a correct GPU may legally render at each pixel, from a
+// nominal render and a list of legal variants (perturbed renders, double precision, adversarial traversal orders),
+// all quantised as an R8G8B8A8_UNORM target holds them; and the judgement of a candidate image against it
+// (docs/compare.md, "Envelope goldens").
+//
+//     Envelope e = makeEnvelope(nominal, {&v1, &v2, ...}, perturbedCount, &orderMask);
+//     writeEnvelope("golden.exr", e);
+//     EnvelopeJudgement j = judgeEnvelope(readEnvelope("golden.exr"), candidate, {});
+//     if (j.verdict != CompareVerdict::Pass) std::cerr << j.describe();
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/compare.h"
+#include "core/image.h"
+
+namespace refray {
+
+inline constexpr std::string_view kEnvelopeFormat = "refray-envelope/1";
+
+// One UNORM8 step: 1/255.
+inline constexpr int kEnvelopeChannels = 3;  // R, G, B are judged; alpha means nothing in the D3D12 samples
+
+enum class PixelClass : uint8_t { Stable = 0, Sensitive = 1 };
+
+struct Envelope {
+    Image nominal;                    // the nominal render, float, as rendered (R, G, B, A)
+    std::vector<std::array<uint8_t, 3>> lo, hi;  // per pixel and channel: UNORM8 codes, min / max over every render
+    std::vector<PixelClass> pixelClass;          // Stable: every render within one step of the nominal's code
+    std::vector<uint8_t> orderDependent;         // 1: the pixel changes under an adversarial traversal order
+    uint32_t perturbedRenders = 0;    // K: the exchangeable samples the statistic counts on (seeds 1..K)
+    uint32_t variants = 0;            // every render the bounds were taken over, the nominal included
+    std::map<std::string, std::string> provenance;  // settings, seeds, commit, variation model, scene SHA-256
+
+    uint32_t width() const { return nominal.width(); }
+    uint32_t height() const { return nominal.height(); }
+    uint64_t sensitivePixels() const;
+};
+
+// The envelope of `nominal` and `variants` (all the same size; throws refray::Error naming the sizes otherwise):
+// bounds over the nominal and every variant, quantised with floatToUnorm8. `perturbedRenders` says how many of the
+// variants are the exchangeable perturbed renders (K). `orderMask` (any non-zero R, G or B) may be null.
+Envelope makeEnvelope(const Image& nominal, const std::vector<const Image*>& variants, uint32_t perturbedRenders,
+                      const Image* orderMask);
+
+// One OpenEXR file, 32-bit float channels R G B A (nominal), lo.R lo.G lo.B hi.R hi.G hi.B (code/255), class
+// (0 stable, 1 sensitive), order (0/1), provenance as refray:* string attributes (docs/golden-format.md).
+// Throws refray::Error naming the path.
+void writeEnvelope(const std::string& path, const Envelope& envelope);
+// Throws refray::Error naming the path for a missing file, a file that is no envelope (no lo.R channel: "a plain
+// image"), another envelope format, or corrupted values (lo > hi, the nominal outside its bounds, class not 0/1).
+Envelope readEnvelope(const std::string& path);
+// Whether the file is an envelope (has the lo.R channel); false for a plain image. Throws when unreadable.
+bool isEnvelopeFile(const std::string& path);
+
+struct EnvelopeJudgeOptions {
+    // The false-alarm probability of the sensitive-pixel count test for one image.
+    double falseAlarm = 1e-3;
+    // Pixels taken as moving together (a shifted silhouette, a marched step more): the count test treats the
+    // sensitive pixels as clusters of this many perfectly correlated pixels (docs/compare.md).
+    uint32_t clusterSize = 9;
+};
+
+struct EnvelopePixel {
+    uint32_t x = 0, y = 0;
+    PixelClass pixelClass = PixelClass::Stable;
+    bool orderDependent = false;
+    bool nonFinite = false;
+    int channel = 0;          // the channel furthest outside
+    int candidate = 0;        // its UNORM8 code in the candidate
+    int allowedLo = 0, allowedHi = 0;  // the codes it was allowed (stable: nominal +-1; sensitive: lo-1 .. hi+1)
+    int steps = 0;            // how far outside, in UNORM8 steps (INT32_MAX for NaN/inf)
+};
+
+struct EnvelopeJudgement {
+    CompareVerdict verdict = CompareVerdict::Pass;
+    std::string mismatch;  // why the verdict is Mismatch
+    uint32_t width = 0, height = 0;
+    uint64_t pixels = 0, stablePixels = 0, sensitivePixels = 0, orderPixels = 0;  // judged pixels by class
+    uint64_t stableOutside = 0, sensitiveOutside = 0, orderOutside = 0, nonFinite = 0;
+    uint32_t perturbedRenders = 0;
+    double outsideProbability = 0;  // per sensitive pixel, for a correct candidate: at most 2/(K+1)
+    double expectedOutside = 0;     // sensitivePixels * outsideProbability
+    uint64_t sensitiveBudget = 0;   // the most sensitive pixels outside that a correct candidate gives (1 - falseAlarm)
+    int maxSteps = 0;
+    std::vector<EnvelopePixel> outside;  // every pixel outside its allowance, in scan order (order pixels included)
+    Image heatMap;                       // see docs/compare.md, "Envelope goldens"
+    std::string describe(size_t listed = 10) const;
+};
+
+// Judges `candidate` (quantised with floatToUnorm8) against `envelope`. Never throws for a size mismatch (the
+// verdict is Mismatch and `mismatch` says why).
+EnvelopeJudgement judgeEnvelope(const Envelope& envelope, const Image& candidate, const EnvelopeJudgeOptions& options);
+
+}  // namespace refray
