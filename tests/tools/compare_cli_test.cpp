@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "core/envelope.h"
 #include "core/image.h"
 #include "tests/tools/browser.h"
 #include "tests/tools/cli_run.h"
@@ -280,4 +281,101 @@ document.body.insertAdjacentHTML('beforeend', '<p id="probe">during=' + during +
     const std::string dom = dumpDom(browser, dir + "/probe.html", dir + "/profile", error);
     ASSERT_TRUE(error.empty()) << error;
     EXPECT_TRUE(contains(dom, "<p id=\"probe\">during=true after=true</p>")) << dom.substr(dom.size() > 3000 ? dom.size() - 3000 : 0);
+}
+
+// ---- Envelope goldens (docs/compare.md, "Envelope goldens") --------------------------------------------------------
+
+namespace {
+
+// A golden directory holding one synthetic envelope "scene.cam" of `unorm(32, 24)`; pixel (0, 0) is sensitive.
+std::string envelopeDirectory(const std::string& name, const std::string& scenePath, const std::string& sceneSha) {
+    const std::string dir = directory(name);
+    const Image nominal = unorm(32, 24);
+    Image moved = nominal;
+    moved.at(0, 0).r += 6.0f / 255.0f;
+    const refray::Envelope e = refray::makeEnvelope(nominal, {&moved}, 1, nullptr);
+    refray::writeEnvelope(dir + "/scene.cam.envelope.exr", e);
+    std::ofstream(dir + "/goldens.json")
+        << "{\"format\": \"refray-goldens/2\", \"goldens\": [{\"name\": \"scene.cam\", \"scene\": \"" << scenePath
+        << "\", \"sceneSha256\": \"" << sceneSha
+        << "\", \"camera\": \"cam\", \"time\": \"0\", \"precision\": \"float\", \"spp\": 1, \"width\": 32, "
+           "\"height\": 24, \"envelope\": \"scene.cam.envelope.exr\", \"perturbedRenders\": 1, \"variationModel\": "
+           "\"variation model v1\", \"sensitivePixels\": 1, \"orderCheckOrders\": 0, \"orderDependentPixels\": 0, "
+           "\"refrayCommit\": \"test\"}]}\n";
+    return dir;
+}
+
+}  // namespace
+
+TEST(CompareCliEnvelope, NominalPassesAndAStablePixelTwoStepsOffFails) {
+    const std::string dir = envelopeDirectory("envelope-pass", "no/such/scene.json", "0");
+    const std::string good = write(dir + "/scene.cam.png", unorm(32, 24));
+    CliRun r = compare("--golden " + dir + " " + good + " --html " + dir + "/report.html -o " + dir + "/heat.png");
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "verdict         PASS")) << r.output;
+    EXPECT_TRUE(std::filesystem::exists(dir + "/report.html"));
+    EXPECT_TRUE(std::filesystem::exists(dir + "/heat.png"));
+    Image bad = unorm(32, 24);
+    bad.at(7, 3).g += 2.0f / 255.0f;
+    const std::string badPath = write(dir + "/bad.png", bad);
+    r = compare("--golden " + dir + "/scene.cam.envelope.exr " + badPath);
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "(7, 3) stable G: code")) << r.output;
+}
+
+TEST(CompareCliEnvelope, AnOlderFormatDirectoryExits4NamingTheManifest) {
+    const std::string dir = directory("envelope-old");
+    std::ofstream(dir + "/goldens.json") << "{\"format\": \"refray-goldens/1\", \"goldens\": []}\n";
+    const std::string c = write(dir + "/x.png", unorm(32, 24));
+    const CliRun r = compare("--golden " + dir + " " + c);
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(contains(r.output, dir + "/goldens.json is a golden directory of format 'refray-goldens/1'")) << r.output;
+    EXPECT_TRUE(contains(r.output, "refray golden update")) << r.output;
+}
+
+TEST(CompareCliEnvelope, ACandidateOfAnotherSizeExits3) {
+    const std::string dir = envelopeDirectory("envelope-size", "no/such/scene.json", "0");
+    const std::string c = write(dir + "/scene.cam.png", unorm(16, 24));
+    const CliRun r = compare("--golden " + dir + " " + c);
+    EXPECT_EQ(r.status, 3) << r.output;
+    EXPECT_TRUE(contains(r.output, c + " is 16x24, the golden " + dir + "/scene.cam.envelope.exr is 32x24")) << r.output;
+}
+
+TEST(CompareCliEnvelope, AGoldenWhoseSceneFileChangedExits4) {
+    const std::string scene = directory("envelope-scene-file") + "/scene.json";
+    std::ofstream(scene) << "{}\n";
+    const std::string dir = envelopeDirectory("envelope-scene", scene, "0123");
+    const std::string c = write(dir + "/scene.cam.png", unorm(32, 24));
+    const CliRun r = compare("--golden " + dir + " " + c);
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(contains(r.output, "was made from " + scene)) << r.output;
+    EXPECT_TRUE(contains(r.output, "that file has changed")) << r.output;
+}
+
+TEST(CompareCliEnvelope, ACorruptedEnvelopeExits4NamingTheFile) {
+    const std::string dir = envelopeDirectory("envelope-corrupt", "no/such/scene.json", "0");
+    std::ofstream(dir + "/scene.cam.envelope.exr", std::ios::binary) << "garbage";
+    const std::string c = write(dir + "/scene.cam.png", unorm(32, 24));
+    const CliRun r = compare("--golden " + dir + " " + c);
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(contains(r.output, dir + "/scene.cam.envelope.exr")) << r.output;
+    EXPECT_TRUE(contains(r.output, "corrupted")) << r.output;
+}
+
+TEST(CompareCliEnvelope, GoldenSetReportsAMissingCandidateAsAFailureWithJUnit) {
+    const std::string dir = envelopeDirectory("envelope-set", "no/such/scene.json", "0");
+    const std::string candidates = directory("envelope-set-candidates");
+    CliRun r = compare("--golden-set " + dir + " " + candidates + " --junit " + candidates + "/results.xml --html " +
+                       candidates + "/report.html");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "scene.cam")) << r.output;
+    EXPECT_TRUE(contains(r.output, "no candidate")) << r.output;
+    std::ifstream junit(candidates + "/results.xml");
+    std::stringstream xml;
+    xml << junit.rdbuf();
+    EXPECT_TRUE(contains(xml.str(), "<testcase classname=\"refray.golden\" name=\"scene.cam\"")) << xml.str();
+    EXPECT_TRUE(contains(xml.str(), "<failure")) << xml.str();
+    write(candidates + "/scene.cam.exr", unorm(32, 24));
+    r = compare("--golden-set " + dir + " " + candidates + " --junit " + candidates + "/results.xml");
+    EXPECT_EQ(r.status, 0) << r.output;
 }

@@ -1,12 +1,17 @@
-// The golden set (tests/golden/goldens.json): every scene file x camera re-rendered and compared with the shared
-// comparator (core/compare.h), masked pixels reported apart. On failure the actual image, the expected one and
-// the diff heat map are written to the test output directory. Goldens change only through `refray golden update`.
+// The golden set (tests/golden/goldens.json): every scene file x camera re-rendered; refray's own nominal render must
+// equal the envelope's nominal bit for bit and pass the envelope judgement (core/envelope.h). Correct renders the
+// envelope was not built from (a perturbation seed outside 1..K, double precision) must pass, a real bug (the Julia
+// set with 150 iterations where the HLSL says 200) must fail. On failure the actual image, the nominal and the heat
+// map are written to the test output directory. Goldens change only through `refray golden update`.
 // Monte Carlo scenes have statistical goldens instead (statistical_golden_test.cpp).
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 
 #include "core/compare.h"
+#include "core/envelope.h"
+#include "scenes/knobs.h"
 #include "core/hash.h"
 #include "verify/golden.h"
 #include "scenes/scene_loader.h"
@@ -35,6 +40,30 @@ namespace {
 
 class Golden : public ::testing::TestWithParam<GoldenEntry> {};
 
+Envelope envelopeOf(const GoldenEntry& golden) { return readEnvelope((kGoldenDirectory / golden.envelope).string()); }
+
+void expectJudgement(const GoldenEntry& golden, const Envelope& envelope, const Image& actual, bool pass,
+                     const std::string& what) {
+    const EnvelopeJudgement j = judgeEnvelope(envelope, actual, {});
+    const bool passed = j.verdict == CompareVerdict::Pass || j.verdict == CompareVerdict::Warn;
+    if (passed == pass) return;
+    const fs::path out = fs::path(REFRAY_TEST_OUTPUT_DIR) / "golden";
+    fs::create_directories(out);
+    writeImage((out / (golden.name + "." + what + ".actual.exr")).string(), actual);
+    writeImage((out / (golden.name + ".nominal.exr")).string(), envelope.nominal);
+    if (!j.heatMap.empty()) writeImage((out / (golden.name + "." + what + ".heat.png")).string(), j.heatMap);
+    ADD_FAILURE() << golden.name << " (" << what << "): expected " << (pass ? "to pass" : "to fail") << ", got "
+                  << toString(j.verdict) << "\n"
+                  << j.describe() << "  actual, nominal and heat map written to " << out.string();
+}
+
+GoldenEntry entryNamed(const std::string& name) {
+    for (const GoldenEntry& e : goldenEntries())
+        if (e.name == name) return e;
+    ADD_FAILURE() << "no golden " << name;
+    return {};
+}
+
 TEST_P(Golden, MatchesTheReRender) {
     const GoldenEntry& golden = GetParam();
     const fs::path scenePath = fs::path(REFRAY_SOURCE_DIR) / golden.scene;
@@ -43,19 +72,43 @@ TEST_P(Golden, MatchesTheReRender) {
 
     Scene scene(loadSceneFile(scenePath));
     const RenderResult actual = scene.render(goldenSettings(golden, 2));
-    const Image expected = readImage((kGoldenDirectory / golden.image).string());
-    const Image mask = readImage((kGoldenDirectory / golden.mask).string());
-    const CompareResult result = compareImages(expected, actual.image, CompareThresholds::golden(), &mask);
-    EXPECT_EQ(result.maskedPixels, golden.orderDependentPixels);
-    if (result.verdict == CompareVerdict::Pass) return;
+    const Envelope envelope = envelopeOf(golden);
+    EXPECT_EQ(envelope.sensitivePixels(), golden.sensitivePixels);
+    uint64_t order = 0;
+    for (uint8_t o : envelope.orderDependent) order += o;
+    EXPECT_EQ(order, golden.orderDependentPixels);
+    ASSERT_EQ(actual.image.pixels().size(), envelope.nominal.pixels().size());
+    size_t differing = 0;
+    for (size_t i = 0; i < actual.image.pixels().size(); ++i)
+        differing += std::memcmp(&actual.image.pixels()[i], &envelope.nominal.pixels()[i], sizeof(vec4)) != 0;
+    EXPECT_EQ(differing, 0u) << golden.name << ": refray's nominal render differs from the golden's nominal";
+    expectJudgement(golden, envelope, actual.image, true, "nominal");
+}
 
-    const fs::path out = fs::path(REFRAY_TEST_OUTPUT_DIR) / "golden";
-    fs::create_directories(out);
-    writeImage((out / (golden.name + ".actual.exr")).string(), actual.image);
-    writeImage((out / (golden.name + ".expected.exr")).string(), expected);
-    writeImage((out / (golden.name + ".diff.png")).string(), result.diffImage);
-    ADD_FAILURE() << golden.name << ": " << toString(result.verdict) << "\n"
-                  << result.describe() << "  actual, expected and diff written to " << out.string();
+// The variants the envelope was built from are seeds 1..K; seed K + 1 is a legal GPU it has not seen.
+TEST(EnvelopeGolden, PerturbedRenderWithAnotherSeedPasses) {
+    const GoldenEntry golden = entryNamed("d3d12-procedural-geometry.default");
+    Scene scene(loadSceneFile(fs::path(REFRAY_SOURCE_DIR) / golden.scene));
+    RenderSettings s = goldenSettings(golden, 2);
+    s.perturbation = goldenPerturbation(golden.perturbedRenders + 1);
+    expectJudgement(golden, envelopeOf(golden), scene.render(s).image, true, "perturbed");
+}
+
+TEST(EnvelopeGolden, DoublePrecisionPasses) {
+    const GoldenEntry golden = entryNamed("proceduray-mandel-julia-pac.julia");
+    Scene scene(loadSceneFile(fs::path(REFRAY_SOURCE_DIR) / golden.scene));
+    RenderSettings s = goldenSettings(golden, 2);
+    s.precision = procedural::Precision::Double;
+    expectJudgement(golden, envelopeOf(golden), scene.render(s).image, true, "double");
+}
+
+// A real bug a GPU port makes: the HLSL iterates the Julia set 200 times.
+TEST(EnvelopeGolden, JuliaWithTooFewIterationsFails) {
+    const GoldenEntry golden = entryNamed("proceduray-mandel-julia-pac.julia");
+    Scene scene(loadSceneFile(fs::path(REFRAY_SOURCE_DIR) / golden.scene));
+    RenderSettings s = goldenSettings(golden, 2);
+    applyKnobAssignment(s, "julia-iterations=150");
+    expectJudgement(golden, envelopeOf(golden), scene.render(s).image, false, "julia-iterations-150");
 }
 
 std::string goldenName(const ::testing::TestParamInfo<GoldenEntry>& info) {
@@ -82,10 +135,7 @@ TEST(GoldenSet, ManifestCoversEveryCameraOfEverySceneFile) {
         }
     }
     EXPECT_EQ(set.entries.size(), cameras);
-    for (const GoldenEntry& e : set.entries) {
-        EXPECT_TRUE(fs::exists(kGoldenDirectory / e.image)) << e.image;
-        EXPECT_TRUE(fs::exists(kGoldenDirectory / e.mask)) << e.mask;
-    }
+    for (const GoldenEntry& e : set.entries) EXPECT_TRUE(fs::exists(kGoldenDirectory / e.envelope)) << e.envelope;
     // Statistical goldens name a Monte Carlo scene's camera and have their statistics image.
     for (const StatisticalGoldenEntry& e : set.statistical) {
         const SceneDesc desc = loadSceneFile(fs::path(REFRAY_SOURCE_DIR) / e.scene);

@@ -1,0 +1,116 @@
+// core/envelope.cpp: making an envelope from renders, its EXR form, and judging a candidate against it.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include "core/envelope.h"
+#include "core/error.h"
+
+namespace refray {
+namespace {
+
+Image flat(uint32_t w, uint32_t h, int code) { return Image(w, h, vec4(float(code) / 255.0f, 0.5f, 0.5f, 1.0f)); }
+
+// 10x10, nominal code 100; pixel (0,0) of every variant moves by `spread` steps, the rest by nothing.
+Envelope twoClassEnvelope(int spread, uint32_t k = 8) {
+    const Image nominal = flat(10, 10, 100);
+    std::vector<Image> variants(k, nominal);
+    for (uint32_t i = 0; i < k; ++i) variants[i].at(0, 0).r = float(100 + (i % 2 ? spread : -spread)) / 255.0f;
+    std::vector<const Image*> pointers;
+    for (const Image& v : variants) pointers.push_back(&v);
+    return makeEnvelope(nominal, pointers, k, nullptr);
+}
+
+TEST(Envelope, ContainsTheNominalAndClassifies) {
+    const Envelope e = twoClassEnvelope(5);
+    EXPECT_EQ(e.variants, 9u);
+    EXPECT_EQ(e.pixelClass[0], PixelClass::Sensitive);
+    EXPECT_EQ(e.lo[0][0], 95);
+    EXPECT_EQ(e.hi[0][0], 105);
+    EXPECT_EQ(e.sensitivePixels(), 1u);
+    for (size_t i = 0; i < e.lo.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_LE(e.lo[i][c], floatToUnorm8(e.nominal.pixels()[i][c]));
+            EXPECT_GE(e.hi[i][c], floatToUnorm8(e.nominal.pixels()[i][c]));
+        }
+    EXPECT_EQ(twoClassEnvelope(1).pixelClass[0], PixelClass::Stable);  // one step is stable
+}
+
+TEST(Envelope, JudgesStablePixelsStrictlyAndSensitiveOnesAgainstTheirBounds) {
+    const Envelope e = twoClassEnvelope(5);
+    Image c = e.nominal;
+    c.at(0, 0).r = 106.0f / 255.0f;  // sensitive: hi + 1 allowed
+    c.at(5, 5).r = 101.0f / 255.0f;  // stable: one step allowed
+    EXPECT_EQ(judgeEnvelope(e, c, {}).verdict, CompareVerdict::Pass);
+    c.at(5, 5).r = 102.0f / 255.0f;  // a stable pixel two steps off: a bug
+    const EnvelopeJudgement j = judgeEnvelope(e, c, {});
+    EXPECT_EQ(j.verdict, CompareVerdict::Fail);
+    EXPECT_EQ(j.stableOutside, 1u);
+    ASSERT_EQ(j.outside.size(), 1u);
+    EXPECT_EQ(j.outside[0].x, 5u);
+    EXPECT_EQ(j.outside[0].steps, 1);
+    EXPECT_EQ(j.heatMap.at(5, 5), vec4(1.0f, 0.0f, 0.0f, 1.0f));
+}
+
+TEST(Envelope, SensitivePixelsOutsideAreCountedAgainstTheBinomialBudget) {
+    const Envelope e = twoClassEnvelope(5);
+    Image c = e.nominal;
+    c.at(0, 0).r = 120.0f / 255.0f;
+    const EnvelopeJudgement j = judgeEnvelope(e, c, {});
+    EXPECT_EQ(j.sensitiveOutside, 1u);
+    EXPECT_EQ(j.outside[0].steps, 14);
+    EXPECT_NEAR(j.outsideProbability, 2.0 / 9.0, 1e-12);
+    EXPECT_EQ(j.sensitiveBudget, 1u);  // one cluster, capped at the sensitive pixels
+    EXPECT_EQ(j.verdict, CompareVerdict::Warn);  // within the budget, above the expected 2/9 pixel
+}
+
+TEST(Envelope, NaNAlwaysFailsAndOrderPixelsAreReportedApart) {
+    const Image nominal = flat(4, 4, 50);
+    Image mask(4, 4, vec4(0.0f, 0.0f, 0.0f, 1.0f));
+    mask.at(1, 1) = vec4(1.0f);
+    const Envelope e = makeEnvelope(nominal, {}, 0, &mask);
+    Image c = nominal;
+    c.at(1, 1).r = 0.9f;
+    EnvelopeJudgement j = judgeEnvelope(e, c, {});
+    EXPECT_EQ(j.orderOutside, 1u);
+    EXPECT_EQ(j.verdict, CompareVerdict::Pass);
+    c.at(1, 1).g = std::numeric_limits<float>::quiet_NaN();
+    j = judgeEnvelope(e, c, {});
+    EXPECT_EQ(j.nonFinite, 1u);
+    EXPECT_EQ(j.verdict, CompareVerdict::Fail);
+    EXPECT_EQ(judgeEnvelope(e, flat(5, 4, 50), {}).verdict, CompareVerdict::Mismatch);
+}
+
+TEST(Envelope, RoundTripsThroughExrAndRefusesCorruptedFiles) {
+    const std::filesystem::path dir = std::filesystem::path(REFRAY_TEST_OUTPUT_DIR) / "envelope";
+    std::filesystem::create_directories(dir);
+    Envelope e = twoClassEnvelope(5);
+    e.provenance["scene_sha256"] = "abc";
+    const std::string path = (dir / "e.envelope.exr").string();
+    writeEnvelope(path, e);
+    EXPECT_TRUE(isEnvelopeFile(path));
+    const Envelope back = readEnvelope(path);
+    EXPECT_EQ(back.lo, e.lo);
+    EXPECT_EQ(back.hi, e.hi);
+    EXPECT_EQ(back.pixelClass, e.pixelClass);
+    EXPECT_EQ(back.perturbedRenders, 8u);
+    EXPECT_EQ(back.provenance.at("scene_sha256"), "abc");
+
+    e.lo[3][1] = 200;  // the nominal (code 128) below its lower bound
+    writeEnvelope(path, e);
+    try {
+        readEnvelope(path);
+        ADD_FAILURE() << "a corrupted envelope was read";
+    } catch (const Error& error) {
+        EXPECT_NE(std::string(error.what()).find("is corrupted at (3, 0)"), std::string::npos) << error.what();
+        EXPECT_NE(std::string(error.what()).find(path), std::string::npos) << error.what();
+    }
+    std::ofstream(path, std::ios::binary) << "not an EXR";
+    EXPECT_THROW(readEnvelope(path), Error);
+}
+
+}  // namespace
+}  // namespace refray
