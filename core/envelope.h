@@ -34,6 +34,11 @@ struct Envelope {
     std::vector<uint8_t> orderDependent;         // 1: the pixel changes under an adversarial traversal order
     uint32_t perturbedRenders = 0;    // K: the exchangeable samples the statistic counts on (seeds 1..K)
     uint32_t variants = 0;            // every render the bounds were taken over, the nominal included
+    // The leave-one-out calibration of the stable-pixel count test (docs/compare.md, "The stable count test"):
+    // c_i, for perturbed render i (seeds 1..K), the pixels (order-dependent ones excepted) that are stable when the
+    // class is taken over the nominal and every other render but i, and that render i moves by more than one step.
+    // Empty for an envelope made before the calibration: its stable pixels get no allowance.
+    std::vector<uint64_t> stableMovesLeaveOneOut;
     std::map<std::string, std::string> provenance;  // settings, seeds, commit, variation model, scene SHA-256
 
     uint32_t width() const { return nominal.width(); }
@@ -86,11 +91,19 @@ struct EnvelopeJudgement {
     double outsideProbability = 0;  // per sensitive pixel, for a correct candidate: at most 2/(K+1)
     double expectedOutside = 0;     // sensitivePixels * outsideProbability
     uint64_t sensitiveBudget = 0;   // the most sensitive pixels outside that a correct candidate gives (1 - falseAlarm)
+    double expectedStableOutside = 0;  // mean(c_i): the stable pixels a correct candidate moves, by leave-one-out
+    uint64_t stableBudget = 0;      // the most stable pixels a correct candidate moves (stableBudget below)
     int maxSteps = 0;
     std::vector<EnvelopePixel> outside;  // every pixel outside its allowance, in scan order (order pixels included)
     Image heatMap;                       // see docs/compare.md, "Envelope goldens"
     std::string describe(size_t listed = 10) const;
 };
+
+// The stable-pixel budget (docs/compare.md, "The stable count test"): with T = sum over i of ceil(c_i / clusterSize)
+// clusters moved by the K leave-one-out renders, the largest y such that P(Binomial(y + T, 1/(K+1)) >= y) > falseAlarm
+// (the conditional test of a candidate's Poisson rate against the K renders'), in pixels (y * clusterSize), and at
+// least max(c_i). 0 for an envelope without the calibration.
+uint64_t stableBudget(const Envelope& envelope, const EnvelopeJudgeOptions& options);
 
 // Judges `candidate` (quantised with floatToUnorm8) against `envelope`. Never throws for a size mismatch (the
 // verdict is Mismatch and `mismatch` says why).

@@ -462,8 +462,9 @@ int runGoldenSet(const CompareCommandOptions& o) {
         if (!r.problem.empty()) std::printf(": %s", r.problem.c_str());
         else if (r.verdict() == CompareVerdict::Mismatch) std::printf(": %s", r.judgement.mismatch.c_str());
         else
-            std::printf(" (stable outside %llu, sensitive outside %llu of allowed %llu, NaN %llu)",
-                        (unsigned long long)r.judgement.stableOutside, (unsigned long long)r.judgement.sensitiveOutside,
+            std::printf(" (stable outside %llu of allowed %llu, sensitive outside %llu of allowed %llu, NaN %llu)",
+                        (unsigned long long)r.judgement.stableOutside, (unsigned long long)r.judgement.stableBudget,
+                        (unsigned long long)r.judgement.sensitiveOutside,
                         (unsigned long long)r.judgement.sensitiveBudget, (unsigned long long)r.judgement.nonFinite);
         std::printf("\n");
     }

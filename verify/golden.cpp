@@ -285,6 +285,18 @@ Envelope renderEnvelope(Scene& scene, GoldenEntry& entry, const EnvelopeRenderOp
     p["order_check_orders"] = std::to_string(entry.orders);
     p["order_dependent_pixels"] = std::to_string(entry.orderDependentPixels);
     p["sensitive_pixels"] = std::to_string(entry.sensitivePixels);
+    {
+        std::string moves;
+        for (uint64_t c : envelope.stableMovesLeaveOneOut) {
+            if (!moves.empty()) moves += ' ';
+            moves += std::to_string(c);
+        }
+        p["stable_moves_loo"] = moves;  // also refray:envelope_stable_moves_loo, which the compare reads
+        p["stable_budget"] = std::to_string(stableBudget(envelope, {}));
+        p["stable_budget_rule"] =
+            "clusters of 9; largest y with P(Binomial(y + T, 1/(K+1)) >= y) > 1e-3, T = sum ceil(c_i/9); at least "
+            "max(c_i); docs/compare.md";
+    }
     p["other_variants"] = "precision double; adversarial orders 1.." + std::to_string(entry.orders);
     p["render_seconds_nominal"] = fixed(nominalSeconds);
     p["render_seconds_perturbed"] = fixed(perturbedSeconds);
