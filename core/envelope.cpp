@@ -241,10 +241,24 @@ Envelope readEnvelope(const std::string& path) {
     return e;
 }
 
-uint64_t stableBudget(const Envelope& e, const EnvelopeJudgeOptions& options) {
-    const std::vector<uint64_t>& moves = e.stableMovesLeaveOneOut;
+uint64_t stableClusterSize(const Envelope& envelope, const EnvelopeJudgeOptions& options) {
+    const std::vector<uint64_t>& moves = envelope.stableMovesLeaveOneOut;
+    uint64_t cluster = std::max<uint32_t>(options.clusterSize, 1);
+    if (moves.size() < 2) return cluster;
+    double mean = 0, variance = 0;
+    for (uint64_t c : moves) mean += double(c);
+    mean /= double(moves.size());
+    for (uint64_t c : moves) variance += (double(c) - mean) * (double(c) - mean);
+    variance /= double(moves.size() - 1);
+    // A compound Poisson count of clusters of m pixels has variance / mean = m.
+    if (mean > 0) cluster = std::max<uint64_t>(cluster, uint64_t(std::ceil(variance / mean)));
+    return cluster;
+}
+
+uint64_t stableBudget(const Envelope& envelope, const EnvelopeJudgeOptions& options) {
+    const std::vector<uint64_t>& moves = envelope.stableMovesLeaveOneOut;
     if (moves.empty()) return 0;
-    const uint64_t cluster = std::max<uint32_t>(options.clusterSize, 1);
+    const uint64_t cluster = stableClusterSize(envelope, options);
     uint64_t clusters = 0, most = 0;
     for (uint64_t c : moves) {
         clusters += (c + cluster - 1) / cluster;

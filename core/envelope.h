@@ -99,9 +99,13 @@ struct EnvelopeJudgement {
     std::string describe(size_t listed = 10) const;
 };
 
-// The stable-pixel budget (docs/compare.md, "The stable count test"): with T = sum over i of ceil(c_i / clusterSize)
+// The cluster size of the stable count test: options.clusterSize, or the dispersion index of the c_i (sample
+// variance / mean: a compound Poisson count of m-pixel clusters has m) where that is larger.
+uint64_t stableClusterSize(const Envelope& envelope, const EnvelopeJudgeOptions& options);
+// The stable-pixel budget (docs/compare.md, "The stable count test"): with m = stableClusterSize and
+// T = sum over i of ceil(c_i / m)
 // clusters moved by the K leave-one-out renders, the largest y such that P(Binomial(y + T, 1/(K+1)) >= y) > falseAlarm
-// (the conditional test of a candidate's Poisson rate against the K renders'), in pixels (y * clusterSize), and at
+// (the conditional test of a candidate's Poisson rate against the K renders'), in pixels (y * m), and at
 // least max(c_i). 0 for an envelope without the calibration.
 uint64_t stableBudget(const Envelope& envelope, const EnvelopeJudgeOptions& options);
 

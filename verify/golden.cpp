@@ -293,9 +293,11 @@ Envelope renderEnvelope(Scene& scene, GoldenEntry& entry, const EnvelopeRenderOp
         }
         p["stable_moves_loo"] = moves;  // also refray:envelope_stable_moves_loo, which the compare reads
         p["stable_budget"] = std::to_string(stableBudget(envelope, {}));
-        p["stable_budget_rule"] =
-            "clusters of 9; largest y with P(Binomial(y + T, 1/(K+1)) >= y) > 1e-3, T = sum ceil(c_i/9); at least "
-            "max(c_i); docs/compare.md";
+        const uint64_t m = stableClusterSize(envelope, {});
+        p["stable_cluster_size"] = std::to_string(m);
+        p["stable_budget_rule"] = "clusters of m = max(9, ceil(var(c_i)/mean(c_i))) pixels; m times the largest y with "
+                                  "P(Binomial(y + T, 1/(K+1)) >= y) > 1e-3, T = sum ceil(c_i/m); at least max(c_i); "
+                                  "docs/compare.md";
     }
     p["other_variants"] = "precision double; adversarial orders 1.." + std::to_string(entry.orders);
     p["render_seconds_nominal"] = fixed(nominalSeconds);

@@ -80,11 +80,15 @@ TEST(Envelope, CalibratesTheStableBudgetByLeaveOneOut) {
     for (const Image& v : variants) pointers.push_back(&v);
     const Envelope e = makeEnvelope(nominal, pointers, 3, &mask);
     EXPECT_EQ(e.stableMovesLeaveOneOut, (std::vector<uint64_t>{30, 1, 0}));
-    // T = ceil(30/9) + ceil(1/9) = 5 clusters; p = 1/4: the largest y with P(Binomial(y + 5, 1/4) >= y) > 1e-3 is 9.
-    EXPECT_EQ(stableBudget(e, {}), 81u);
-    EnvelopeJudgeOptions one;
-    one.clusterSize = 1;  // T = 31 pixels gives y = 25; the budget still covers max(c_i) = 30, which a render did
-    EXPECT_EQ(stableBudget(e, one), 30u);
+    // The c_i scatter more than 9-pixel clusters allow: mean 31/3, sample variance 290.3, so clusters of
+    // ceil(290.3 / 10.33) = 29; T = ceil(30/29) + ceil(1/29) = 3 clusters; p = 1/4: the largest y with
+    // P(Binomial(y + 3, 1/4) >= y) > 1e-3 is 8, so 8 x 29 pixels.
+    EXPECT_EQ(stableClusterSize(e, {}), 29u);
+    EXPECT_EQ(stableBudget(e, {}), 232u);
+    // Counts as even as Poisson 9-pixel clusters keep the cluster size of the options.
+    Envelope even = e;
+    even.stableMovesLeaveOneOut = {20, 21, 22};
+    EXPECT_EQ(stableClusterSize(even, {}), 9u);
 
     const std::filesystem::path dir = std::filesystem::path(REFRAY_TEST_OUTPUT_DIR) / "envelope";
     std::filesystem::create_directories(dir);
