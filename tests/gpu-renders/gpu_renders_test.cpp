@@ -89,9 +89,9 @@ TEST(GpuRenders, TheRoundIsRecorded) {
            "tools/gpu_crosscheck.sh on a machine with a ray-tracing GPU and import its tar with "
            "tools/gpu_crosscheck.sh --import (docs/gpu-crosscheck.md)";
     const json::Value& p = round().provenance;
-    EXPECT_FALSE(member(p, "gpu").empty());
-    EXPECT_FALSE(member(p, "gpuDriver").empty());
-    EXPECT_FALSE(member(p, "vulkanAPI").empty());
+    EXPECT_FALSE(member(p, "gpu").empty()) << "provenance.json names no GPU";
+    EXPECT_FALSE(member(p, "gpuDriver").empty()) << "provenance.json names no driver";
+    EXPECT_FALSE(member(p, "vulkanAPI").empty()) << "provenance.json names no Vulkan API version";
     EXPECT_TRUE(std::any_of(round().renders.begin(), round().renders.end(),
                             [](const Recorded& r) { return r.what == "image"; }))
         << "the GPU renders are missing: provenance.json lists no rendered image";
