@@ -99,14 +99,14 @@ while IFS=$'\t' read -r what name scene camera time wh precision aov output; do
   [ "$time" != "-" ] && args+=(--time "$time")
   case "$what" in
     image)
-      echo "== image $name"
+      echo "== image $name ($(( $(date +%s) - start )) s)"
       gpu_render "${args[@]}" --precision "$precision" -o "$dir/$output" || true ;;
     map)
-      echo "== map $name $aov"
+      echo "== map $name $aov ($(( $(date +%s) - start )) s)"
       gpu_render "${args[@]}" --aov "$aov" -o "$dir/$output" || true ;;
     speed)
       for run in 1 2 3; do
-        echo "== speed $name $wh run $run"
+        echo "== speed $name $wh run $run ($(( $(date +%s) - start )) s)"
         t0=$(date +%s.%N)
         gpu_render "${args[@]}" --precision "$precision" -o "$work/speed.exr" || continue
         t1=$(date +%s.%N)
