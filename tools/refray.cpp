@@ -313,7 +313,7 @@ int runRender(const RenderOptions& o) {
                      "files");
         const Size size = parseSize(o.size.empty() ? "640x360" : o.size);
         settings.width = size.width, settings.height = size.height;
-        device = tools::useRenderDevice(o.device, "builtin", o.spirvDir, settings);
+        device = tools::useRenderDevice(o.device, "builtin", nullptr, o.spirvDir, settings);
         scenes::BuiltinScene scene;
         const auto renderOnce = [&](const scenes::RenderSettings& s) {
             scenes::RenderResult r = scene.render(s);
@@ -330,7 +330,7 @@ int runRender(const RenderOptions& o) {
         effects = effectSet.list();
         const Size size = o.size.empty() ? Size{scene->desc().defaultWidth, scene->desc().defaultHeight} : parseSize(o.size);
         settings.width = size.width, settings.height = size.height;
-        device = tools::useRenderDevice(o.device, scene->desc().shaderLibrary, o.spirvDir, settings);
+        device = tools::useRenderDevice(o.device, scene->desc().shaderLibrary, &scene->desc(), o.spirvDir, settings);
         if (!o.aov.empty()) {
             renderIndexMap(*scene, settings, o, device);
             return 0;

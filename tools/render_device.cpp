@@ -7,11 +7,13 @@
 
 #ifdef REFRAY_HAVE_VULKAN
 #include "gpu/vulkan_dispatch.h"
+#include "tools/device_trace_ray.h"
 #endif
 
 namespace refray::tools {
 
-RenderDevice makeRenderDevice(const std::string& device, const std::string& library, const std::string& spirvDirectory) {
+RenderDevice makeRenderDevice(const std::string& device, const std::string& library, const scenes::SceneDesc* scene,
+                              const std::string& spirvDirectory) {
     REFRAY_CHECK(device == "cpu" || device == "vulkan", "--device expects 'cpu' or 'vulkan', got '" << device << "'");
     RenderDevice out;
     if (device == "cpu") {
@@ -21,6 +23,7 @@ RenderDevice makeRenderDevice(const std::string& device, const std::string& libr
 #ifdef REFRAY_HAVE_VULKAN
     gpu::VulkanBackendOptions options;
     options.library = library;
+    options.traceRay = deviceTraceRayConstants(library, scene);
     options.spirvDirectory = spirvDirectory.empty()
                                  ? gpu::defaultSpirvDirectory(std::filesystem::read_symlink("/proc/self/exe"))
                                  : std::filesystem::path(spirvDirectory);
@@ -56,7 +59,7 @@ RenderDevice makeRenderDevice(const std::string& device, const std::string& libr
     out.state = backend;
     return out;
 #else
-    (void)library;
+    (void)library, (void)scene;
     throw Error("--device vulkan: this refray was built without the Vulkan back end (configure found no "
                 "libvulkan-dev, glslang-tools or spirv-tools, or REFRAY_VULKAN=OFF)");
 #endif
@@ -110,10 +113,10 @@ void checkVulkanSettings(const scenes::RenderSettings& settings) {
                  "--device vulkan: the GPU traverses in its own order; --order adversarial is the emulator's");
 }
 
-RenderDevice useRenderDevice(const std::string& device, const std::string& library, const std::string& spirvDirectory,
-                             scenes::RenderSettings& settings) {
+RenderDevice useRenderDevice(const std::string& device, const std::string& library, const scenes::SceneDesc* scene,
+                             const std::string& spirvDirectory, scenes::RenderSettings& settings) {
     if (device == "vulkan") checkVulkanSettings(settings);
-    RenderDevice out = makeRenderDevice(device, library, spirvDirectory);
+    RenderDevice out = makeRenderDevice(device, library, scene, spirvDirectory);
     settings.backend = out.backend;
     return out;
 }

@@ -10,6 +10,7 @@
 
 #include "inspect/index_map.h"
 #include "scenes/render_settings.h"
+#include "scenes/scene_desc.h"
 
 namespace refray::tools {
 
@@ -24,15 +25,18 @@ struct RenderDevice {
         aov;
 };
 
-// `device` is "cpu" or "vulkan"; `library` the scene's shader library (the SPIR-V folder); `spirvDirectory` the
-// --spirv-dir option (empty: REFRAY_SPIRV_DIR or next to the executable). Throws refray::Error when the device is
-// unknown, when this refray was built without the Vulkan back end, or when no ray-tracing device is found (the
-// message says what is missing).
-RenderDevice makeRenderDevice(const std::string& device, const std::string& library, const std::string& spirvDirectory);
+// `device` is "cpu" or "vulkan"; `library` the scene's shader library (the SPIR-V folder); `scene` the scene file's
+// description (nullptr: the built-in scene), whose ray types' TraceRay arguments the GLSL ports receive as
+// specialization constants (tools/device_trace_ray.h); `spirvDirectory` the --spirv-dir option (empty:
+// REFRAY_SPIRV_DIR or next to the executable). Throws refray::Error when the device is unknown, when this refray was
+// built without the Vulkan back end, when the TraceRay arguments cannot be determined, or when no ray-tracing device
+// is found (the message says what is missing).
+RenderDevice makeRenderDevice(const std::string& device, const std::string& library, const scenes::SceneDesc* scene,
+                              const std::string& spirvDirectory);
 
 // makeRenderDevice, and for `vulkan` checkVulkanSettings(settings); sets settings.backend.
-RenderDevice useRenderDevice(const std::string& device, const std::string& library, const std::string& spirvDirectory,
-                             scenes::RenderSettings& settings);
+RenderDevice useRenderDevice(const std::string& device, const std::string& library, const scenes::SceneDesc* scene,
+                             const std::string& spirvDirectory, scenes::RenderSettings& settings);
 
 // `refray render --aov KIND`: the index map of each pixel's primary ray, from the emulator's trace
 // (scenes::renderIndexMap) or, on a device with `aov`, from its AOV dispatch. The device reports the record index it
