@@ -38,7 +38,7 @@ uint32_t valueOf(const gpu::SpecializationData& data, uint32_t rayType, TraceRay
     return v.value_or(0xDEADBEEFu);
 }
 
-TEST(TraceRaySpecialization, ConstantIdsLeaveTheAovOffsetAlone) {
+TEST(VulkanTraceRaySpecialization, ConstantIdsLeaveTheAovOffsetAlone) {
     EXPECT_EQ(traceRayConstantId(0, TraceRayField::RayContribution), 16u);
     EXPECT_EQ(traceRayConstantId(0, TraceRayField::InstanceInclusionMask), 19u);
     EXPECT_EQ(traceRayConstantId(1, TraceRayField::RayContribution), 32u);
@@ -59,7 +59,7 @@ TEST(TraceRaySpecialization, ConstantIdsLeaveTheAovOffsetAlone) {
 }
 
 // The lesson patches both ray types with "traceRay": {"multiplier": 1}; the GPU must trace with M = 1 too.
-TEST(TraceRaySpecialization, MultiplierOneLessonGivesMOne) {
+TEST(VulkanTraceRaySpecialization, MultiplierOneLessonGivesMOne) {
     const scenes::SceneDesc lesson = scenes::loadSceneFile(kScenes / "lessons" / "multiplier-one.json");
     ASSERT_EQ(lesson.shaderLibrary, "d3d12-procedural-geometry");
     const gpu::SpecializationData data = specializationOf(lesson);
@@ -73,7 +73,7 @@ TEST(TraceRaySpecialization, MultiplierOneLessonGivesMOne) {
 
 // The reference scenes override nothing: the HLSL's arguments, R = r, M = 2, miss index r, mask ~0 (the GLSL
 // defaults, so a pipeline given them means the same as one given none).
-TEST(TraceRaySpecialization, ReferenceScenesGiveTheHlslArguments) {
+TEST(VulkanTraceRaySpecialization, ReferenceScenesGiveTheHlslArguments) {
     for (const char* file : {"d3d12-procedural-geometry.json", "proceduray-mandel-julia-pac.json"}) {
         SCOPED_TRACE(file);
         const gpu::SpecializationData data = specializationOf(scenes::loadSceneFile(kScenes / file));
@@ -89,7 +89,7 @@ TEST(TraceRaySpecialization, ReferenceScenesGiveTheHlslArguments) {
               (std::vector<TraceRayConstants>{{0, 2, 0, 0xFF}, {1, 2, 1, 0xFF}}));
 }
 
-TEST(TraceRaySpecialization, RefusesWhatItCannotDetermine) {
+TEST(VulkanTraceRaySpecialization, RefusesWhatItCannotDetermine) {
     EXPECT_THROW(deviceTraceRayConstants("d3d12-procedural-geometry", nullptr), Error);
     const scenes::SceneDesc d3d12 = scenes::loadSceneFile(kScenes / "d3d12-procedural-geometry.json");
     EXPECT_THROW(deviceTraceRayConstants("proceduray", &d3d12), Error);
@@ -100,7 +100,7 @@ TEST(TraceRaySpecialization, RefusesWhatItCannotDetermine) {
 
 // Every OpTraceRayKHR of every compiled GLSL port takes its cull mask, SBT offset, SBT stride and miss index from
 // specialization constants decorated SpecId traceRayConstantId(r, field), so no library hard-codes them.
-TEST(TraceRaySpecialization, EveryTraceRayReadsSpecializationConstants) {
+TEST(VulkanTraceRaySpecialization, EveryTraceRayReadsSpecializationConstants) {
     constexpr uint32_t kOpDecorate = 71, kDecorationSpecId = 1, kOpTraceRayKHR = 4445;
     size_t traces = 0;
     for (const char* library : {"builtin", "d3d12-procedural-geometry", "proceduray"}) {
