@@ -154,7 +154,11 @@ dxr::DispatchResult VulkanBackend::run(dxr::Device& device, const dxr::DispatchR
     }
     const PipelineShape shape =
         describePipeline(*stateObject, options_.spirvDirectory, options_.library, aovShaders ? &*aovShaders : nullptr);
-    RayTracingPipeline rayTracingPipeline(context, shape, sets.pipelineLayout(), recordIndexOffset);
+    REFRAY_CHECK(!options_.traceRay.empty(),
+                 "the Vulkan back end was given no TraceRay arguments for the " << options_.library
+                     << " shaders' ray types (VulkanBackendOptions::traceRay); the GLSL ports read them as "
+                        "specialization constants");
+    RayTracingPipeline rayTracingPipeline(context, shape, sets.pipelineLayout(), options_.traceRay, recordIndexOffset);
 
     // The shader binding table, in device memory at a shaderGroupBaseAlignment-aligned address.
     translation.groupHandle = [&](uint32_t entry) { return rayTracingPipeline.groupHandles().at(entry); };

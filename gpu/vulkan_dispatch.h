@@ -12,6 +12,7 @@
 
 #include "emulator/device.h"
 #include "gpu/vulkan_context.h"
+#include "gpu/vulkan_pipeline.h"
 
 namespace refray::gpu {
 
@@ -21,6 +22,10 @@ struct VulkanBackendOptions {
     // The shader library the state objects come from: the folder of their SPIR-V ("proceduray",
     // "d3d12-procedural-geometry", "builtin").
     std::string library;
+    // What the library's shaders pass to TraceRay for each ray type: the scene's effective arguments (its library's
+    // defaults with each ray type's "traceRay" applied), which the GLSL ports read as specialization constants.
+    // The host (tools/device_trace_ray.h) fills them in; a dispatch with none refuses to run.
+    std::vector<TraceRayConstants> traceRay;
 };
 
 // What an AOV dispatch reports per launch index (row-major), each kAovMiss where the primary ray missed.

@@ -107,8 +107,35 @@ std::vector<uint32_t> readSpirv(const PipelineStage& stage) {
 
 }  // namespace
 
+std::optional<uint32_t> SpecializationData::valueOf(uint32_t constantId) const {
+    for (size_t i = 0; i < entries.size(); ++i)
+        if (entries[i].constantID == constantId) return values[entries[i].offset / sizeof(uint32_t)];
+    return std::nullopt;
+}
+
+VkSpecializationInfo SpecializationData::info() const {
+    return {uint32_t(entries.size()), entries.data(), values.size() * sizeof(uint32_t), values.data()};
+}
+
+SpecializationData specializationData(const std::vector<TraceRayConstants>& traceRay, uint32_t recordIndexOffset) {
+    SpecializationData out;
+    const auto add = [&](uint32_t constantId, uint32_t value) {
+        out.entries.push_back({constantId, uint32_t(out.values.size() * sizeof(uint32_t)), sizeof(uint32_t)});
+        out.values.push_back(value);
+    };
+    add(kRecordIndexOffsetConstantId, recordIndexOffset);
+    for (uint32_t r = 0; r < traceRay.size(); ++r) {
+        const TraceRayConstants& t = traceRay[r];
+        add(traceRayConstantId(r, TraceRayField::RayContribution), t.rayContribution);
+        add(traceRayConstantId(r, TraceRayField::Multiplier), t.multiplier);
+        add(traceRayConstantId(r, TraceRayField::MissShaderIndex), t.missShaderIndex);
+        add(traceRayConstantId(r, TraceRayField::InstanceInclusionMask), t.instanceInclusionMask);
+    }
+    return out;
+}
+
 RayTracingPipeline::RayTracingPipeline(const VulkanContext& context, const PipelineShape& shape, VkPipelineLayout layout,
-                                       uint32_t recordIndexOffset)
+                                       const std::vector<TraceRayConstants>& traceRay, uint32_t recordIndexOffset)
     : context_(context) {
     const VulkanFunctions& f = context.vk();
     const RayTracingLimits& limits = context.limits();
@@ -137,15 +164,16 @@ RayTracingPipeline::RayTracingPipeline(const VulkanContext& context, const Pipel
             modules.push_back(module);
         }
 
-        const VkSpecializationMapEntry entry{0, 0, sizeof(uint32_t)};
-        const VkSpecializationInfo specialization{1, &entry, sizeof(uint32_t), &recordIndexOffset};
+        // Every stage gets the same constants; each module reads the ids it declares.
+        const SpecializationData constants = specializationData(traceRay, recordIndexOffset);
+        const VkSpecializationInfo specialization = constants.info();
         std::vector<VkPipelineShaderStageCreateInfo> stages;
         for (size_t i = 0; i < shape.stages.size(); ++i) {
             auto s = vkStruct<VkPipelineShaderStageCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO);
             s.stage = translateStage(shape.stages[i].stage);
             s.module = modules[i];
             s.pName = "main";
-            if (shape.stages[i].aovClosestHit) s.pSpecializationInfo = &specialization;
+            s.pSpecializationInfo = &specialization;
             stages.push_back(s);
         }
         std::vector<VkRayTracingShaderGroupCreateInfoKHR> groups;

@@ -33,11 +33,50 @@ struct AovShaders {
     uint32_t recordIndexOffset = 0;    // specialization constant 0 of the closest hit
 };
 
+// The TraceRay arguments the shaders pass for one ray type (DXR's RayContributionToHitGroupIndex R,
+// MultiplierForGeometryContributionToHitGroupIndex M, MissShaderIndex and InstanceInclusionMask). The GLSL ports read
+// them as specialization constants (docs/vulkan-backend.md, "TraceRay arguments a scene overrides become
+// specialization constants"): ray type r's field f is constant_id traceRayConstantId(r, f), and a constant the host
+// gives no value keeps the GLSL default, the HLSL's own argument. The scene's ray flags are not overridable (a scene
+// file's "traceRay" has no flags key), so they stay the GLSL's constants.
+struct TraceRayConstants {
+    uint32_t rayContribution = 0;
+    uint32_t multiplier = 0;
+    uint32_t missShaderIndex = 0;
+    uint32_t instanceInclusionMask = 0xFF;
+
+    friend bool operator==(const TraceRayConstants&, const TraceRayConstants&) = default;
+};
+
+// constant_id = 16 * (rayType + 1) + field: ids 0..15 stay free (the AOV closest hit's record-index offset is 0).
+enum class TraceRayField : uint32_t { RayContribution = 0, Multiplier = 1, MissShaderIndex = 2, InstanceInclusionMask = 3 };
+inline constexpr uint32_t kTraceRayConstantStride = 16;
+inline constexpr uint32_t kTraceRayFieldCount = 4;
+constexpr uint32_t traceRayConstantId(uint32_t rayType, TraceRayField field) {
+    return kTraceRayConstantStride * (rayType + 1) + uint32_t(field);
+}
+// The AOV closest hit's record-index offset (gpu/shaders/aov/ClosestHit_AOV.rchit).
+inline constexpr uint32_t kRecordIndexOffsetConstantId = 0;
+
+// The specialization data every stage of a pipeline gets: one 4-byte uint per constant, in `entries` order.
+struct SpecializationData {
+    std::vector<VkSpecializationMapEntry> entries;
+    std::vector<uint32_t> values;
+    // The value given for `constantId`, or nullopt where none is.
+    std::optional<uint32_t> valueOf(uint32_t constantId) const;
+    VkSpecializationInfo info() const;  // points into this object
+};
+
+// Pure: ray type r's four TraceRay arguments at traceRayConstantId(r, field), and the record-index offset at
+// kRecordIndexOffsetConstantId (a map entry for an id a module does not declare changes nothing, Vulkan spec
+// VkSpecializationInfo). The mask is passed whole; only its low 8 bits count (INST-4).
+SpecializationData specializationData(const std::vector<TraceRayConstants>& traceRay, uint32_t recordIndexOffset = 0);
+
 struct PipelineStage {
     std::string exportName;
     dxr::ShaderStage stage = dxr::ShaderStage::RayGeneration;
     std::filesystem::path spirv;
-    bool aovClosestHit = false;  // gets the record-index offset as specialization constant 0
+    bool aovClosestHit = false;  // reads the record-index offset (specialization constant 0)
 };
 
 struct PipelineGroup {
@@ -65,8 +104,10 @@ class RayTracingPipeline {
 public:
     // Throws refray::Error naming the export and the file when a stage's SPIR-V is missing or unreadable, and when
     // the recursion depth exceeds the device's maxRayRecursionDepth.
+    // `traceRay`: the TraceRay arguments of each ray type, given to every stage as specialization constants
+    // (specializationData); `recordIndexOffset`: the AOV closest hit's.
     RayTracingPipeline(const VulkanContext& context, const PipelineShape& shape, VkPipelineLayout layout,
-                       uint32_t recordIndexOffset = 0);
+                       const std::vector<TraceRayConstants>& traceRay, uint32_t recordIndexOffset = 0);
     ~RayTracingPipeline();
     RayTracingPipeline(const RayTracingPipeline&) = delete;
     RayTracingPipeline& operator=(const RayTracingPipeline&) = delete;

@@ -27,41 +27,36 @@ std::optional<IndexMapKind> parseIndexMapKind(const std::string& name) {
 
 namespace {
 
-// What the recorder keeps per pixel. Each launch index is written by one thread only.
-struct PixelTrace {
-    bool primarySeen = false, primaryDone = false, hit = false;
-    uint32_t rayContribution = 0, multiplier = 0, missShaderIndex = 0;
-    uint32_t instanceIndex = 0, geometryIndex = 0, primitiveIndex = 0;
-    uint32_t maxDepth = 0;
-};
-
+// Fills each pixel's PrimaryHit from the trace events. Each launch index is written by one thread only.
 class PixelRecorder : public dxr::TraceObserver {
 public:
     PixelRecorder(uint32_t width, uint32_t height) : width_(width), pixels_(size_t(width) * height) {}
     void onEvent(const TraceEvent& e) override {
         if (e.kind != TraceEvent::Kind::TraceRay && e.kind != TraceEvent::Kind::TraceRayEnd) return;
-        PixelTrace& p = pixels_[size_t(e.launchIndex.y) * width_ + e.launchIndex.x];
+        const size_t i = size_t(e.launchIndex.y) * width_ + e.launchIndex.x;
+        PrimaryHit& p = pixels_[i];
         if (e.kind == TraceEvent::Kind::TraceRay) {
             p.maxDepth = std::max(p.maxDepth, e.depth);
-            if (e.depth == 1 && !p.primarySeen) {
-                p.primarySeen = true;
+            if (e.depth == 1 && !p.traced) {
+                p.traced = true;
                 p.rayContribution = e.rayContribution;
                 p.multiplier = e.multiplier;
                 p.missShaderIndex = e.missShaderIndex;
             }
-        } else if (e.depth == 1 && p.primarySeen && !p.primaryDone) {
-            p.primaryDone = true;
+        } else if (e.depth == 1 && p.traced && !done_[i]) {
+            done_[i] = true;
             p.hit = e.committed;
             p.instanceIndex = e.instanceIndex;
             p.geometryIndex = e.geometryIndex;
             p.primitiveIndex = e.primitiveIndex;
         }
     }
-    const std::vector<PixelTrace>& pixels() const { return pixels_; }
+    const std::vector<PrimaryHit>& pixels() const { return pixels_; }
 
 private:
     uint32_t width_;
-    std::vector<PixelTrace> pixels_;
+    std::vector<PrimaryHit> pixels_;
+    std::vector<char> done_ = std::vector<char>(pixels_.size(), 0);  // the primary ray's TraceRayEnd was seen
 };
 
 // Distinct colours for the values of one map by their rank: Kelly's 20 colours of maximum contrast (white
@@ -86,47 +81,70 @@ vec4 depthColour(int64_t depth, int64_t deepest) {
 
 }  // namespace
 
-IndexMap renderIndexMap(Scene& scene, const RenderSettings& settings, IndexMapKind kind) {
+std::vector<PrimaryHit> renderPrimaryHits(Scene& scene, const RenderSettings& settings, RenderResult* rendered) {
     REFRAY_CHECK(settings.spp == 1, "index maps show the GPU's one primary ray per pixel; --aov needs --spp 1");
-    const SceneDesc& desc = scene.desc();
     PixelRecorder recorder(settings.width, settings.height);
     RenderSettings s = settings;
     s.observer = &recorder;
+    RenderResult result = scene.render(s);
+    if (rendered) *rendered = std::move(result);
+    return recorder.pixels();
+}
+
+IndexMap renderIndexMap(Scene& scene, const RenderSettings& settings, IndexMapKind kind) {
+    RenderResult rendered;
+    IndexMap out = indexMapOf(scene.desc(), settings.width, settings.height, kind,
+                              renderPrimaryHits(scene, settings, &rendered));
+    out.dispatch = std::move(rendered.dispatch);
+    out.map.metadata = std::move(rendered.image.metadata);
+    out.map.metadata["aov"] = indexMapKindNames()[size_t(kind)];
+    return out;
+}
+
+IndexMap indexMapOf(const SceneDesc& desc, uint32_t width, uint32_t height, IndexMapKind kind,
+                    const std::vector<PrimaryHit>& pixels) {
+    REFRAY_CHECK(pixels.size() == size_t(width) * height,
+                 "an index map of " << width << "x" << height << " needs " << size_t(width) * height
+                                    << " primary hits, got " << pixels.size());
     IndexMap out;
     out.kind = kind;
-    RenderResult rendered = scene.render(s);
-    out.dispatch = std::move(rendered.dispatch);
-
     // Pixel -> value.
-    const auto& pixels = recorder.pixels();
     out.values.resize(pixels.size(), -1);
     std::map<int64_t, std::string> labels;
     int64_t deepest = 0;
     for (size_t i = 0; i < pixels.size(); ++i) {
-        const PixelTrace& p = pixels[i];
+        const PrimaryHit& p = pixels[i];
         int64_t value = -1;
         std::string label;
         if (kind == IndexMapKind::Depth) {
             value = p.maxDepth;
             label = p.maxDepth == 0 ? "no TraceRay" : "ray tree depth " + std::to_string(p.maxDepth);
-        } else if (!p.primarySeen || !p.hit) {
+        } else if (!p.traced || !p.hit) {
             value = -1;
-            label = p.primarySeen ? "miss (MissShaderIndex " + std::to_string(p.missShaderIndex) + ")" : "no primary ray";
+            label = p.traced ? "miss (MissShaderIndex " + std::to_string(p.missShaderIndex) + ")" : "no primary ray";
         } else {
-            const InstanceDescFile& inst = desc.instances.at(p.instanceIndex);
+            REFRAY_CHECK(p.instanceIndex < desc.instances.size(),
+                         "pixel (" << i % width << "," << i / width << ") hit InstanceIndex " << p.instanceIndex
+                                   << "; the scene has " << desc.instances.size() << " instances");
+            const InstanceDescFile& inst = desc.instances[p.instanceIndex];
             const dxr::HitGroupIndexTerms terms =
                 dxr::hitGroupRecordIndex(p.rayContribution, p.multiplier, p.geometryIndex, inst.contribution);
-            const bool inTable = terms.index < desc.hitGroupRecords.size();
+            const uint64_t record = p.record.value_or(terms.index);
+            const bool inTable = record < desc.hitGroupRecords.size();
             const std::string group = !inTable ? "(past the end of the table)"
-                                      : desc.hitGroupRecords[terms.index].hitGroup.empty()
+                                      : desc.hitGroupRecords[record].hitGroup.empty()
                                           ? "NULL"
-                                          : desc.hitGroupRecords[terms.index].hitGroup;
+                                          : desc.hitGroupRecords[record].hitGroup;
+            const std::string equation = std::to_string(terms.rayContribution) + " + " + std::to_string(terms.multiplier) +
+                                         "*" + std::to_string(terms.geometryIndex) + " + " +
+                                         std::to_string(terms.instanceContribution);
             switch (kind) {
                 case IndexMapKind::Record:
-                    value = int64_t(terms.index);
-                    label = "record " + std::to_string(terms.index) + ": " + group + " (I = " + std::to_string(terms.rayContribution) +
-                            " + " + std::to_string(terms.multiplier) + "*" + std::to_string(terms.geometryIndex) + " + " +
-                            std::to_string(terms.instanceContribution) + ")";
+                    value = int64_t(record);
+                    label = "record " + std::to_string(record) + ": " + group +
+                            (record == terms.index ? " (I = " + equation + ")"
+                                                   : " (reported; R + M*G + C = " + equation + " = " +
+                                                         std::to_string(terms.index) + ")");
                     break;
                 case IndexMapKind::Instance:
                     value = p.instanceIndex;
@@ -157,7 +175,7 @@ IndexMap renderIndexMap(Scene& scene, const RenderSettings& settings, IndexMapKi
     }
 
     // Colours and legend.
-    out.map = Image(settings.width, settings.height);
+    out.map = Image(width, height);
     std::map<int64_t, IndexMapEntry> entries;
     int64_t rank = 0;
     for (const auto& [value, label] : labels) {
@@ -173,9 +191,33 @@ IndexMap renderIndexMap(Scene& scene, const RenderSettings& settings, IndexMapKi
         out.map.pixels()[i] = e.colour;
     }
     for (auto& [value, e] : entries) out.legend.push_back(e);
-    out.map.metadata = std::move(rendered.image.metadata);
-    out.map.metadata["aov"] = indexMapKindNames()[size_t(kind)];
     return out;
+}
+
+Image indexValuesImage(const IndexMap& map) {
+    Image out(map.map.width(), map.map.height());
+    for (size_t i = 0; i < map.values.size(); ++i) {
+        const int64_t v = map.values[i];
+        REFRAY_CHECK(v >= -1 && v < (int64_t(1) << 24),
+                     "index value " << v << " at pixel " << i << " has no exact float32; the map's EXR cannot hold it");
+        out.pixels()[i] = vec4(float(v), float(v), float(v), 1.0f);
+    }
+    out.metadata = map.map.metadata;
+    out.metadata["aov_values"] = "R = G = B = the index (-1: miss), exact in float32";
+    return out;
+}
+
+std::vector<int64_t> readIndexValues(const Image& image) {
+    std::vector<int64_t> values(image.pixels().size());
+    for (size_t i = 0; i < values.size(); ++i) {
+        const vec4 p = image.pixels()[i];
+        const int64_t v = int64_t(p.r);
+        REFRAY_CHECK(p.r == p.g && p.r == p.b && float(v) == p.r && v >= -1,
+                     "pixel (" << i % image.width() << "," << i / image.width() << ") of the index values is ("
+                               << p.r << ", " << p.g << ", " << p.b << "), not one index in R, G and B");
+        values[i] = v;
+    }
+    return values;
 }
 
 Image withLegend(const IndexMap& map, const std::string& title, bool* drewText) {

@@ -7,7 +7,7 @@
 #   .gpu-bundle/debs/*.deb      the Debian packages of the shared libraries refray uses (Embree, oneTBB,
 #                               OpenImageIO, OpenEXR, libpng, ...), unpacked by tools/gpu_run.sh with `dpkg -x`
 #                               into .gpu-bundle/lib (never into /)
-#   .gpu-bundle/stubs/*.so.*    stubs of the format libraries OpenImageIO links but refray never calls
+#   .gpu-bundle/stand-ins/*.so.*    stand-ins of the format libraries OpenImageIO links but refray never calls
 #                               (tools/gpu_bundle_libraries.py)
 #   .gpu-bundle/gl/*.deb        the Vulkan loader and the glvnd set the NVIDIA ICD needs, unpacked into / there
 #   .gpu-bundle/MANIFEST        what is in it, with sizes
@@ -48,13 +48,13 @@ spirv="$build_dir/gpu/shaders"
 [ -d "$spirv" ] || { echo "gpu_bundle.sh: no $spirv: this build has no Vulkan back end (REFRAY_VULKAN)" >&2; exit 1; }
 
 rm -rf "$bundle"
-mkdir -p "$bundle/debs" "$bundle/gl" "$bundle/shaders" "$bundle/stubs"
+mkdir -p "$bundle/debs" "$bundle/gl" "$bundle/shaders" "$bundle/stand-ins"
 cp "$binary" "$bundle/refray"
 strip "$bundle/refray"
 (cd "$spirv" && find . -name '*.spv' -exec cp --parents {} "$bundle/shaders/" \;)
 
 # 2. The libraries: those refray uses travel as their Debian packages; the format plug-ins OpenImageIO links but
-#    refray never calls (ffmpeg, OpenCV, DCMTK, OpenVDB, ...: 120 MiB of packages) as generated stubs
+#    refray never calls (ffmpeg, OpenCV, DCMTK, OpenVDB, ...: 120 MiB of packages) as generated stand-ins
 #    (tools/gpu_bundle_libraries.py says which and why).
 python3 "$root/tools/gpu_bundle_libraries.py" "$binary" "$bundle"
 declare -A packages=()
@@ -76,14 +76,14 @@ done < "$bundle/carried.txt"
 (cd "$bundle/gl" && apt-get download libvulkan1 libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2 2>&1 \
    | grep -v '^W: Download is performed unsandboxed' || true)
 
-# The check: refray runs from the packages and stubs alone, with no library of this machine but the C and C++
+# The check: refray runs from the packages and stand-ins alone, with no library of this machine but the C and C++
 # runtimes (the dynamic loader's cache off), and writes a PNG and an EXR.
 check=$(mktemp -d)
 trap 'rm -rf "$check"' EXIT
 mkdir -p "$check/root" "$check/lib" "$check/runtime"
 for f in "$bundle"/debs/*.deb; do dpkg -x "$f" "$check/root"; done
 find "$check/root" -name '*.so*' \( -type f -o -type l \) -exec ln -sf {} "$check/lib/" \;
-cp "$bundle"/stubs/*.so* "$check/lib/"
+cp "$bundle"/stand-ins/*.so* "$check/lib/"
 for s in libc.so.6 libm.so.6 libdl.so.2 libpthread.so.0 librt.so.1 libstdc++.so.6 libgcc_s.so.1; do
   ln -sf "/lib/x86_64-linux-gnu/$s" "$check/runtime/$s"
 done
@@ -93,7 +93,7 @@ if ! "${isolated[@]}" render builtin --size 32x18 -o "$check/check.png" >/dev/nu
   echo "gpu_bundle.sh: refray does not run from the bundle's libraries alone (above: what it lacked)" >&2
   exit 1
 fi
-echo "checked: refray renders from the bundle's libraries and stubs alone"
+echo "checked: refray renders from the bundle's libraries and stand-ins alone"
 
 # 3. Manifest and size.
 {
@@ -101,7 +101,7 @@ echo "checked: refray renders from the bundle's libraries and stubs alone"
   echo "binary: $binary"
   echo "spirv modules: $(find "$bundle/shaders" -name '*.spv' | wc -l)"
   echo "target ldconfig: ${target_ldconfig:-none (every package of the closure)}"
-  echo "stubs (stubs/): $(cd "$bundle/stubs" && ls | tr '\n' ' ')"
+  echo "stand-ins (stand-ins/): $(cd "$bundle/stand-ins" && ls | tr '\n' ' ')"
   echo "packages (debs/):"
   (cd "$bundle/debs" && ls -1 *.deb | sed 's/^/  /')
   echo "loader (gl/):"

@@ -1,16 +1,16 @@
 #!/usr/bin/env python3
-"""Which shared libraries the GPU bundle carries, and stub libraries for the rest (tools/gpu_bundle.sh).
+"""Which shared libraries the GPU bundle carries, and stand-in libraries for the rest (tools/gpu_bundle.sh).
 
 OpenImageIO 2.4 on Debian 12 loads ffmpeg, OpenCV, OpenVDB, DCMTK, LibRaw, libheif, OpenColorIO, libtiff, ... for
 image formats refray never reads or writes on the GPU machine (it writes PNG and EXR). Their packages and what
 they load come to about 120 MiB of .debs, more than a device call carries. So the bundle carries the libraries
 refray really uses (Embree, oneTBB, OpenImageIO, OpenEXR, libpng, libjpeg, FreeType, ...) and, for each library
-in STUBBED, a stub with the same soname that defines exactly the symbols (and symbol versions) the carried
-libraries import from it. Each stub function aborts with a message naming itself, so a stub that is ever called
-says so instead of misbehaving. On the GPU machine tools/gpu_run.sh links a stub only where the machine has no
+in STAND_INS, a stand-in with the same soname that defines exactly the symbols (and symbol versions) the carried
+libraries import from it. Each stand-in function aborts with a message naming itself, so a stand-in that is ever called
+says so instead of misbehaving. On the GPU machine tools/gpu_run.sh links a stand-in only where the machine has no
 library of that soname.
 
-  gpu_bundle_libraries.py BINARY OUTDIR  ->  OUTDIR/carried.txt (soname path, one a line) and OUTDIR/stubs/*.so
+  gpu_bundle_libraries.py BINARY OUTDIR  ->  OUTDIR/carried.txt (soname path, one a line) and OUTDIR/stand-ins/*.so
 """
 import os
 import re
@@ -18,20 +18,20 @@ import subprocess
 import sys
 
 # Format plug-ins and colour management OpenImageIO links but refray's PNG/EXR output never calls.
-STUBBED = {
+STAND_INS = {
     "libopencv_core.so.406", "libopencv_imgproc.so.406", "libopencv_videoio.so.406",
     "libdcmimage.so.17", "libdcmimgle.so.17", "libdcmdata.so.17", "liboflog.so.17", "libofstd.so.17",
     "libavcodec.so.59", "libavformat.so.59", "libavutil.so.57", "libswscale.so.6",
     "libgif.so.7", "libheif.so.1", "libopenjp2.so.7", "libopenvdb.so.10.0", "libraw_r.so.20",
     "libwebp.so.7", "libwebpdemux.so.2", "libOpenColorIO.so.2.1", "libtiff.so.6",
 }
-# What OpenImageIO calls of the stubbed libraries before it writes a PNG or EXR (found by running refray on the stubs
+# What OpenImageIO calls of the replaced by stand-ins libraries before it writes a PNG or EXR (found by running refray on the stand-ins
 # alone, tools/gpu_bundle.sh's check): C++ constructors and destructors (Itanium mangling C1/C2/C3, D0/D1/D2; its
-# static initialisers construct DCMTK's DiRegister) and libtiff's handler setters. These stubs return instead of
+# static initialisers construct DCMTK's DiRegister) and libtiff's handler setters. These stand-ins return instead of
 # trapping; the objects stay zero and unused.
 INERT = re.compile(r"(C[123]|D[012])E|^TIFFSet(Error|Warning)Handler$")
 # Version queries: OpenImageIO asks every format library for its version when it lists its plug-ins (before it
-# writes any file), so these stubs answer "" (an empty string, which also reads as a harmless number).
+# writes any file), so these stand-ins answer "" (an empty string, which also reads as a harmless number).
 VERSION = re.compile(r"version", re.IGNORECASE)
 # The C and C++ runtimes: every Linux machine has them (Ubuntu 24.04's are newer than Debian 12's).
 SYSTEM = {"libc.so.6", "libm.so.6", "libdl.so.2", "libpthread.so.0", "librt.so.1", "ld-linux-x86-64.so.2",
@@ -73,14 +73,14 @@ def dynamic_symbols(path):
 def main():
     binary, outdir = sys.argv[1], sys.argv[2]
     paths = library_paths()
-    # Carried: the closure of the binary's NEEDED, without the runtimes and without what a stub replaces.
-    carried, stubs_needed, todo = {}, set(), needed(binary)
+    # Carried: the closure of the binary's NEEDED, without the runtimes and without what a stand-in replaces.
+    carried, stand_ins_needed, todo = {}, set(), needed(binary)
     while todo:
         soname = todo.pop()
         if soname in SYSTEM or soname in carried:
             continue
-        if soname in STUBBED:
-            stubs_needed.add(soname)
+        if soname in STAND_INS:
+            stand_ins_needed.add(soname)
             continue
         if soname not in paths:
             sys.exit(f"gpu_bundle_libraries.py: {soname} is not installed here")
@@ -92,8 +92,8 @@ def main():
     for path in carried.values():
         imports.update((n, v) for n, v, defined, _, _ in dynamic_symbols(path) if not defined)
 
-    os.makedirs(os.path.join(outdir, "stubs"), exist_ok=True)
-    for soname in sorted(stubs_needed):
+    os.makedirs(os.path.join(outdir, "stand-ins"), exist_ok=True)
+    for soname in sorted(stand_ins_needed):
         real = paths[soname]
         functions, objects, nodes = [], [], {}
         for name, version, defined, kind, size in dynamic_symbols(real):
@@ -106,12 +106,12 @@ def main():
             else:
                 continue
             nodes.setdefault(version, []).append(name)
-        base = os.path.join(outdir, "stubs", soname)
+        base = os.path.join(outdir, "stand-ins", soname)
         with open(base + ".c", "w") as c:
-            c.write("/* Generated by tools/gpu_bundle_libraries.py: a stub of %s for the GPU bundle. */\n" % soname)
+            c.write("/* Generated by tools/gpu_bundle_libraries.py: a stand-in of %s for the GPU bundle. */\n" % soname)
             c.write("extern int dprintf(int, const char*, ...);\n")
-            c.write("static void stub_called(const char* name) {\n"
-                    "    dprintf(2, \"refray: %%s of the GPU bundle's stub %s was called; carry the real "
+            c.write("static void stand_in_called(const char* name) {\n"
+                    "    dprintf(2, \"refray: %%s of the GPU bundle's stand-in %s was called; carry the real "
                     "library\\n\", name);\n    __builtin_trap();\n}\n" % soname)
             for name in functions:
                 if VERSION.search(name):
@@ -119,7 +119,7 @@ def main():
                 elif INERT.search(name):
                     c.write("void %s(void) {}\n" % name)  # a constructor/destructor a static initialiser runs
                 else:
-                    c.write("void %s(void) { stub_called(\"%s\"); }\n" % (name, name))
+                    c.write("void %s(void) { stand_in_called(\"%s\"); }\n" % (name, name))
             for name, size in objects:
                 c.write("char %s[%d] __attribute__((aligned(16)));\n" % (name, size))
         with open(base + ".map", "w") as m:
@@ -135,7 +135,7 @@ def main():
     with open(os.path.join(outdir, "carried.txt"), "w") as f:
         for soname, path in sorted(carried.items()):
             f.write("%s %s\n" % (soname, path))
-    print("%d libraries carried, %d stubbed" % (len(carried), len(stubs_needed)))
+    print("%d libraries carried, %d replaced by stand-ins" % (len(carried), len(stand_ins_needed)))
 
 
 if __name__ == "__main__":

@@ -7,7 +7,7 @@
 #   bash tools/gpu_run.sh ARGS...               refray ARGS... (any subcommand)
 #
 # It installs the Vulkan loader and the glvnd set into / (dpkg -x; as the device README says), unpacks the
-# library packages into .gpu-bundle/unpacked and links into .gpu-bundle/lib (never into /) each library and stub the
+# library packages into .gpu-bundle/unpacked and links into .gpu-bundle/lib (never into /) each library and stand-in the
 # machine lacks, puts that folder on LD_LIBRARY_PATH, prints the libraries refray still lacks, and points refray at
 # the bundle's SPIR-V. docs/vulkan-backend.md, "Running on the GPU
 # machine".
@@ -38,10 +38,10 @@ if [ ! -d "$bundle/lib" ]; then
     name=$(basename "$file")
     if ! grep -q "^[[:space:]]*$name " <<<"$system_libraries"; then ln -sf "$file" "$bundle/lib/$name"; fi
   done < <(find "$bundle/unpacked" -name '*.so.*' \( -type f -o -type l \))
-  # Stubs of the format libraries OpenImageIO links but refray never calls (tools/gpu_bundle_libraries.py).
-  for stub in "$bundle"/stubs/*.so*; do
-    name=$(basename "$stub")
-    if ! grep -q "^[[:space:]]*$name " <<<"$system_libraries"; then ln -sf "$stub" "$bundle/lib/$name"; fi
+  # Stand-ins of the format libraries OpenImageIO links but refray never calls (tools/gpu_bundle_libraries.py).
+  for standin in "$bundle"/stand-ins/*.so*; do
+    name=$(basename "$standin")
+    if ! grep -q "^[[:space:]]*$name " <<<"$system_libraries"; then ln -sf "$standin" "$bundle/lib/$name"; fi
   done
 fi
 export LD_LIBRARY_PATH="$bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"

@@ -187,16 +187,24 @@ struct RenderOptions {
     std::string spirvDir;            // --spirv-dir
 };
 
+bool endsWithExr(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext == ".exr";
+}
+
 // --aov: the index map with its legend beside it; the legend also goes to stdout.
-void renderIndexMap(scenes::Scene& scene, const scenes::RenderSettings& settings, const RenderOptions& o) {
+// -o FILE.exr: the values themselves (scenes::indexValuesImage), for exact comparison.
+void renderIndexMap(scenes::Scene& scene, const scenes::RenderSettings& settings, const RenderOptions& o,
+                    const tools::RenderDevice& device) {
     const std::optional<scenes::IndexMapKind> kind = scenes::parseIndexMapKind(o.aov);
     REFRAY_CHECK(kind, "--aov expects one of " << joined(scenes::indexMapKindNames()) << ", got '" << o.aov << "'"
                                                << didYouMean(o.aov, scenes::indexMapKindNames()));
     REFRAY_CHECK(o.orderCheck == 0, "--aov and --order-check are separate renders; give one of them");
-    const scenes::IndexMap map = scenes::renderIndexMap(scene, settings, *kind);
+    const scenes::IndexMap map = tools::renderDeviceIndexMap(device, scene, settings, *kind);
     const std::string title = scene.desc().name + ": " + o.aov + " of each pixel's primary ray";
     bool drewText = true;
-    Image image = scenes::withLegend(map, title, &drewText);
+    Image image = endsWithExr(o.output) ? scenes::indexValuesImage(map) : scenes::withLegend(map, title, &drewText);
     image.metadata["refray_version"] = tools::kVersion;
     image.metadata["refray_commit"] = tools::kCommit;
     writeOutput(o.output, image);
@@ -208,12 +216,6 @@ void renderIndexMap(scenes::Scene& scene, const scenes::RenderSettings& settings
     std::printf("wrote %s\n", o.output.c_str());
 }
 
-
-bool endsWithExr(const std::string& path) {
-    std::string ext = std::filesystem::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return ext == ".exr";
-}
 
 // --batches K: renders K times with seeds S, S+1, ..., S+K-1 (a line per batch) and returns their statistics; `last`
 // receives the last batch's render (for --stats).
@@ -296,8 +298,8 @@ int runRender(const RenderOptions& o) {
     settings.profileStages = (o.stats || !o.statsJson.empty()) && !o.noStageTimes;
     settings.specialise = !o.noShortcuts;
 
-    REFRAY_CHECK(o.device != "vulkan" || (o.aov.empty() && o.orderCheck == 0),
-                 "--device vulkan renders the image; --aov and --order-check need the emulator's trace and orders");
+    REFRAY_CHECK(o.device != "vulkan" || o.orderCheck == 0,
+                 "--device vulkan renders in the GPU's own traversal order; --order-check needs the emulator's orders");
     tools::RenderDevice device;  // --device: set once the scene's shader library is known
     scenes::RenderResult result;
     std::optional<StatisticsImage> statistics;  // --batches
@@ -311,7 +313,7 @@ int runRender(const RenderOptions& o) {
                      "files");
         const Size size = parseSize(o.size.empty() ? "640x360" : o.size);
         settings.width = size.width, settings.height = size.height;
-        device = tools::useRenderDevice(o.device, "builtin", o.spirvDir, settings);
+        device = tools::useRenderDevice(o.device, "builtin", nullptr, o.spirvDir, settings);
         scenes::BuiltinScene scene;
         const auto renderOnce = [&](const scenes::RenderSettings& s) {
             scenes::RenderResult r = scene.render(s);
@@ -328,9 +330,9 @@ int runRender(const RenderOptions& o) {
         effects = effectSet.list();
         const Size size = o.size.empty() ? Size{scene->desc().defaultWidth, scene->desc().defaultHeight} : parseSize(o.size);
         settings.width = size.width, settings.height = size.height;
-        device = tools::useRenderDevice(o.device, scene->desc().shaderLibrary, o.spirvDir, settings);
+        device = tools::useRenderDevice(o.device, scene->desc().shaderLibrary, &scene->desc(), o.spirvDir, settings);
         if (!o.aov.empty()) {
-            renderIndexMap(*scene, settings, o);
+            renderIndexMap(*scene, settings, o, device);
             return 0;
         }
         if (o.orderCheck > 0) {
@@ -453,7 +455,8 @@ int main(int argc, char** argv) {
                      "the search: no shortcuts (for measuring them; the image is the same)");
     render->add_option("--aov", ro.aov,
                        "Write an index map instead of the render: record|instance|geometry|primitive|hitgroup|depth "
-                       "of each pixel's primary ray, false-coloured, with a legend");
+                       "of each pixel's primary ray, false-coloured, with a legend (-o FILE.exr: the values "
+                       "themselves, R = G = B = the index, -1 for a miss, exact)");
     render->add_option("--device", ro.device,
                        "Where DispatchRays runs: cpu (the emulator) or vulkan (the same DXR state translated to a Vulkan "
                        "ray-tracing GPU; docs/vulkan-backend.md)")

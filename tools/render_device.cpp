@@ -1,16 +1,19 @@
 #include "tools/render_device.h"
 
+#include <cstdio>
 #include <filesystem>
 
 #include "core/error.h"
 
 #ifdef REFRAY_HAVE_VULKAN
 #include "gpu/vulkan_dispatch.h"
+#include "tools/device_trace_ray.h"
 #endif
 
 namespace refray::tools {
 
-RenderDevice makeRenderDevice(const std::string& device, const std::string& library, const std::string& spirvDirectory) {
+RenderDevice makeRenderDevice(const std::string& device, const std::string& library, const scenes::SceneDesc* scene,
+                              const std::string& spirvDirectory) {
     REFRAY_CHECK(device == "cpu" || device == "vulkan", "--device expects 'cpu' or 'vulkan', got '" << device << "'");
     RenderDevice out;
     if (device == "cpu") {
@@ -20,6 +23,7 @@ RenderDevice makeRenderDevice(const std::string& device, const std::string& libr
 #ifdef REFRAY_HAVE_VULKAN
     gpu::VulkanBackendOptions options;
     options.library = library;
+    options.traceRay = deviceTraceRayConstants(library, scene);
     options.spirvDirectory = spirvDirectory.empty()
                                  ? gpu::defaultSpirvDirectory(std::filesystem::read_symlink("/proc/self/exe"))
                                  : std::filesystem::path(spirvDirectory);
@@ -30,6 +34,23 @@ RenderDevice makeRenderDevice(const std::string& device, const std::string& libr
         return raw->dispatchRays(d, desc, pipeline, globals, dispatchOptions);
     };
     const gpu::DeviceInfo& info = backend->deviceInfo();
+    out.aov = [raw](dxr::Device& d, const dxr::DispatchRaysDesc& desc, const dxr::StateObjectPtr& pipeline,
+                    const dxr::GlobalRootArguments* globals) {
+        const gpu::AovPixels aov = raw->dispatchAov(d, desc, pipeline, globals);
+        std::vector<scenes::PrimaryHit> hits(aov.record.size());
+        for (size_t i = 0; i < hits.size(); ++i) {
+            scenes::PrimaryHit& h = hits[i];
+            h.traced = true;
+            h.hit = aov.record[i] != gpu::AovPixels::kAovMiss;
+            if (!h.hit) continue;
+            h.record = aov.record[i];
+            h.instanceIndex = aov.instanceIndex[i];
+            h.geometryIndex = aov.geometryIndex[i];
+            h.primitiveIndex = aov.primitiveIndex[i];
+            h.instanceID = aov.instanceID[i];
+        }
+        return hits;
+    };
     out.provenance["device"] = "vulkan";
     out.provenance["gpu"] = info.name;
     out.provenance["gpu_driver"] = info.driverName + " " + info.driverVersion;
@@ -38,10 +59,49 @@ RenderDevice makeRenderDevice(const std::string& device, const std::string& libr
     out.state = backend;
     return out;
 #else
-    (void)library;
+    (void)library, (void)scene;
     throw Error("--device vulkan: this refray was built without the Vulkan back end (configure found no "
                 "libvulkan-dev, glslang-tools or spirv-tools, or REFRAY_VULKAN=OFF)");
 #endif
+}
+
+scenes::IndexMap renderDeviceIndexMap(const RenderDevice& device, scenes::Scene& scene,
+                                      const scenes::RenderSettings& settings, scenes::IndexMapKind kind) {
+    if (!device.aov) return scenes::renderIndexMap(scene, settings, kind);
+    REFRAY_CHECK(kind != scenes::IndexMapKind::Depth,
+                 "--aov depth needs the emulator's trace of every ray; the device's AOV dispatch sees only primary rays");
+    REFRAY_CHECK(settings.spp == 1, "index maps show the GPU's one primary ray per pixel; --aov needs --spp 1");
+    const scenes::SceneDesc& desc = scene.desc();
+    REFRAY_CHECK(!desc.rayTypes.empty(), "scene '" << desc.name << "' has no ray types to trace");
+    std::vector<scenes::PrimaryHit> hits;
+    scenes::RenderSettings s = settings;
+    s.backend = [&](dxr::Device& d, const dxr::DispatchRaysDesc& desc_, const dxr::StateObjectPtr& pipeline,
+                    const dxr::GlobalRootArguments* globals, const dxr::DispatchOptions&) {
+        hits = device.aov(d, desc_, pipeline, globals);
+        return dxr::DispatchResult{};
+    };
+    scenes::RenderResult rendered = scene.render(s);
+    // The primary ray's TraceRay arguments: the first ray type's.
+    const scenes::RayTypeDesc& primary = desc.rayTypes.front();
+    uint64_t otherInstanceIDs = 0;  // pixels whose InstanceID() is not the scene's for their InstanceIndex()
+    for (scenes::PrimaryHit& h : hits) {
+        h.rayContribution = primary.rayContribution;
+        h.multiplier = primary.multiplier;
+        h.missShaderIndex = primary.missShaderIndex;
+        if (h.hit && h.instanceID && h.instanceIndex < desc.instances.size() &&
+            (*h.instanceID & 0xFFFFFFu) != (desc.instances[h.instanceIndex].instanceID & 0xFFFFFFu))
+            ++otherInstanceIDs;
+    }
+    scenes::IndexMap map = scenes::indexMapOf(desc, settings.width, settings.height, kind, hits);
+    if (otherInstanceIDs > 0)
+        std::fprintf(stderr, "refray: warning: on %llu pixels the device's InstanceID() is not the scene's InstanceID "
+                             "of the InstanceIndex() it reports\n",
+                     (unsigned long long)otherInstanceIDs);
+    map.map.metadata = std::move(rendered.image.metadata);
+    map.map.metadata["aov"] = scenes::indexMapKindNames()[size_t(kind)];
+    for (const auto& [key, value] : device.provenance) map.map.metadata[key] = value;
+    map.map.metadata["aov_instance_id_mismatches"] = std::to_string(otherInstanceIDs);
+    return map;
 }
 
 void checkVulkanSettings(const scenes::RenderSettings& settings) {
@@ -53,10 +113,10 @@ void checkVulkanSettings(const scenes::RenderSettings& settings) {
                  "--device vulkan: the GPU traverses in its own order; --order adversarial is the emulator's");
 }
 
-RenderDevice useRenderDevice(const std::string& device, const std::string& library, const std::string& spirvDirectory,
-                             scenes::RenderSettings& settings) {
+RenderDevice useRenderDevice(const std::string& device, const std::string& library, const scenes::SceneDesc* scene,
+                             const std::string& spirvDirectory, scenes::RenderSettings& settings) {
     if (device == "vulkan") checkVulkanSettings(settings);
-    RenderDevice out = makeRenderDevice(device, library, spirvDirectory);
+    RenderDevice out = makeRenderDevice(device, library, scene, spirvDirectory);
     settings.backend = out.backend;
     return out;
 }

@@ -2,11 +2,15 @@
 // either way; with `vulkan` its DXR state is translated to Vulkan and traced on the GPU (gpu/vulkan_dispatch.h).
 #pragma once
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "inspect/index_map.h"
 #include "scenes/render_settings.h"
+#include "scenes/scene_desc.h"
 
 namespace refray::tools {
 
@@ -14,17 +18,33 @@ struct RenderDevice {
     scenes::DispatchBackend backend;                // empty: the emulator
     std::map<std::string, std::string> provenance;  // image metadata: device, gpu, gpu_driver, vulkan_api
     std::shared_ptr<void> state;                    // keeps the back end alive while `backend` is in use
+    // `--aov` on the device (empty: the emulator's trace): the AOV dispatch for `backend`'s arguments, each launch
+    // index's primary hit as the device reports it (docs/vulkan-backend.md, "AOVs").
+    std::function<std::vector<scenes::PrimaryHit>(dxr::Device&, const dxr::DispatchRaysDesc&, const dxr::StateObjectPtr&,
+                                                  const dxr::GlobalRootArguments*)>
+        aov;
 };
 
-// `device` is "cpu" or "vulkan"; `library` the scene's shader library (the SPIR-V folder); `spirvDirectory` the
-// --spirv-dir option (empty: REFRAY_SPIRV_DIR or next to the executable). Throws refray::Error when the device is
-// unknown, when this refray was built without the Vulkan back end, or when no ray-tracing device is found (the
-// message says what is missing).
-RenderDevice makeRenderDevice(const std::string& device, const std::string& library, const std::string& spirvDirectory);
+// `device` is "cpu" or "vulkan"; `library` the scene's shader library (the SPIR-V folder); `scene` the scene file's
+// description (nullptr: the built-in scene), whose ray types' TraceRay arguments the GLSL ports receive as
+// specialization constants (tools/device_trace_ray.h); `spirvDirectory` the --spirv-dir option (empty:
+// REFRAY_SPIRV_DIR or next to the executable). Throws refray::Error when the device is unknown, when this refray was
+// built without the Vulkan back end, when the TraceRay arguments cannot be determined, or when no ray-tracing device
+// is found (the message says what is missing).
+RenderDevice makeRenderDevice(const std::string& device, const std::string& library, const scenes::SceneDesc* scene,
+                              const std::string& spirvDirectory);
 
 // makeRenderDevice, and for `vulkan` checkVulkanSettings(settings); sets settings.backend.
-RenderDevice useRenderDevice(const std::string& device, const std::string& library, const std::string& spirvDirectory,
-                             scenes::RenderSettings& settings);
+RenderDevice useRenderDevice(const std::string& device, const std::string& library, const scenes::SceneDesc* scene,
+                             const std::string& spirvDirectory, scenes::RenderSettings& settings);
+
+// `refray render --aov KIND`: the index map of each pixel's primary ray, from the emulator's trace
+// (scenes::renderIndexMap) or, on a device with `aov`, from its AOV dispatch. The device reports the record index it
+// chose, InstanceIndex, GeometryIndex and PrimitiveIndex; R, M and the miss index in the labels are the scene's
+// first ray type's (the one every ray-generation shader traces), so the two maps have the same values, colours and
+// legend wherever they agree. `depth` needs the emulator's trace. The map's metadata carries the device's provenance.
+scenes::IndexMap renderDeviceIndexMap(const RenderDevice& device, scenes::Scene& scene,
+                                      const scenes::RenderSettings& settings, scenes::IndexMapKind kind);
 
 // The Vulkan back end renders the shaders as the GLSL ports wrote them: float, the HLSL's constants, ordered
 // traversal, whole images. Throws refray::Error naming the first option that asks for more.

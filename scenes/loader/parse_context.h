@@ -40,7 +40,6 @@ struct ParseContext {
     std::shared_ptr<dxr::ShaderLibrary> library;
     const Value* values = nullptr;
     std::vector<std::string> structNames;
-    std::vector<StructDesc> structs;
     std::vector<std::string> hitGroupNames, localNames, blasNames, instanceNames, modelNames;
     std::vector<Model> models;  // scene.models, loaded
     SignatureInfo globalInfo;

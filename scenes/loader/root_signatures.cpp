@@ -147,7 +147,7 @@ dxr::RootSignatureDesc parseSignature(const ParseContext& ctx, const Value& valu
                 uint32_t count = 0;
                 if (const Value* s = pr.optional("struct")) {
                     pi.structIndex = int32_t(resolveName(*s, ctx.structNames, "struct"));
-                    count = ctx.structs[size_t(pi.structIndex)].dwords;
+                    count = ctx.scene.structs[size_t(pi.structIndex)].dwords;
                 }
                 if (const Value* c = pr.optional("count")) {
                     if (pi.structIndex >= 0 && c->asUint32() != count)

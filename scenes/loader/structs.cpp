@@ -83,7 +83,6 @@ void parseStructs(ParseContext& ctx, const Value& value) {
         }
         if (layout.dwords == 0) m.value.fail("struct " + inQuotes(m.key) + " has no fields");
         ctx.structNames.push_back(m.key);
-        ctx.structs.push_back(layout);
         ctx.scene.structs.push_back(std::move(layout));
     }
 }
@@ -99,7 +98,7 @@ std::vector<uint32_t> constantValue(const ParseContext& ctx, const Value& value,
         for (const Value& v : a) d.push_back(encodeScalar(v, ScalarKind::Float, what));
         return d;
     }
-    const StructLayout& layout = ctx.structs[size_t(structIndex)];
+    const StructLayout& layout = ctx.scene.structs[size_t(structIndex)];
     if (value.isString()) {
         std::vector<std::string> names;
         const Value* found = nullptr;

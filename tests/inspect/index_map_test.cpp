@@ -5,6 +5,7 @@
 
 #include "inspect/index_map.h"
 #include "scenes/scene.h"
+#include "tests/error_of.h"
 #include "tests/scenes/scene_test_support.h"
 
 namespace refray::scenes {
@@ -85,6 +86,36 @@ TEST(IndexMap, KindNames) {
     EXPECT_EQ(parseIndexMapKind("hitgroup"), IndexMapKind::HitGroup);
     EXPECT_EQ(parseIndexMapKind("depth"), IndexMapKind::Depth);
     EXPECT_FALSE(parseIndexMapKind("records"));
+}
+
+TEST(IndexMap, TheValuesImageHoldsTheValuesExactly) {
+    auto scene = loadScene(kProceduray);
+    const IndexMap records = renderIndexMap(*scene, small(), IndexMapKind::Record);
+    const Image values = indexValuesImage(records);
+    EXPECT_EQ(values.metadata.at("aov"), "record");
+    EXPECT_EQ(readIndexValues(values), records.values);
+    Image bad = values;
+    bad.pixels()[3].g = 7.0f;
+    EXPECT_EQ(refray::testing::errorOf([&] { readIndexValues(bad); }),
+              "pixel (3,0) of the index values is (-1, 7, -1), not one index in R, G and B");
+}
+
+TEST(IndexMap, ADeviceReportedRecordIsTheValueAndItsLabelSaysSo) {
+    auto scene = loadScene(kProceduray);
+    const RenderSettings s = small();
+    std::vector<PrimaryHit> hits = renderPrimaryHits(*scene, s);
+    const IndexMap fromTrace = indexMapOf(scene->desc(), s.width, s.height, IndexMapKind::Record, hits);
+    // A device that reports the record R + M*G + C gives the same map.
+    for (PrimaryHit& h : hits)
+        if (h.hit) h.record = 2 * h.instanceIndex;
+    EXPECT_EQ(indexMapOf(scene->desc(), s.width, s.height, IndexMapKind::Record, hits).legend[2].label,
+              fromTrace.legend[2].label);
+    EXPECT_EQ(indexMapOf(scene->desc(), s.width, s.height, IndexMapKind::Record, hits).values, fromTrace.values);
+    // One that reports another record: its value, and the equation it broke.
+    for (PrimaryHit& h : hits)
+        if (h.hit && h.instanceIndex == 1) h.record = 3;
+    const IndexMap other = indexMapOf(scene->desc(), s.width, s.height, IndexMapKind::Record, hits);
+    EXPECT_EQ(other.legend[2].label, "record 3: HitGroup_Julia_Shadow (reported; R + M*G + C = 0 + 2*0 + 2 = 2)");
 }
 
 }  // namespace

@@ -51,7 +51,7 @@ std::string vec3Text(double x, double y, double z) {
 // What varies between the scenes of this file: where the world origin is, the spheres' instance scale, the camera
 // and light (given for offset 0), and whether the ground plane is there. A scaled instance is tested apart: at the
 // Julia's scale 100 x 30 x 100 the spheres are hit but the sample's distance fog turns every pixel to background
-// (HazardScale.D3D12SpheresUnderTheJuliaScaleAreHitButFogged in hazards_test.cpp).
+// (HazardScale.D3D12SpheresUnderTheJuliaScaleAreHitButFogged in hazards_emulator_test.cpp).
 struct Layout {
     double offset[3] = {0, 0, 0};
     double scale[3] = {1, 1, 1};

@@ -49,6 +49,20 @@ struct MaterialConstants {
 };
 
 const uint kRayTypeCount = 2u;  // radiance = 0, shadow = 1
+
+// PORT: TraceRay arguments a scene overrides become specialization constants (docs/vulkan-backend.md). refray's C++
+// library takes each ray type's R, M, miss index and mask from the scene (a ray type's "traceRay", e.g. the lesson
+// scenes/lessons/multiplier-one.json); the host (gpu/vulkan_pipeline.h, traceRayConstantId) gives ray type r's
+// field f as constant_id 16 * (r + 1) + f: 0 R, 1 M, 2 miss index, 3 mask. The defaults are the C++ shaders' own
+// arguments (procedural/builtin/builtin_shaders.cpp), so with no values given this file means them. The ray flags stay constants (a scene cannot override them).
+layout(constant_id = 16) const uint kTraceRayRadiance_RayContribution = 0u;
+layout(constant_id = 17) const uint kTraceRayRadiance_Multiplier = 2u;
+layout(constant_id = 18) const uint kTraceRayRadiance_MissShaderIndex = 0u;
+layout(constant_id = 19) const uint kTraceRayRadiance_InstanceMask = 0xFFu;
+layout(constant_id = 32) const uint kTraceRayShadow_RayContribution = 1u;
+layout(constant_id = 33) const uint kTraceRayShadow_Multiplier = 2u;
+layout(constant_id = 34) const uint kTraceRayShadow_MissShaderIndex = 1u;
+layout(constant_id = 35) const uint kTraceRayShadow_InstanceMask = 0xFFu;
 const uint kMaxRecursionDepth = 3u;
 const float kTMax = 10000.0;
 const float kFixedTMin = 0.001;
@@ -131,8 +145,10 @@ vec3 hitWorldPosition() { return WorldRayOrigin() + RayTCurrent() * WorldRayDire
 vec4 traceRadiance(RayDesc ray, uint depth) {
     if (depth >= kMaxRecursionDepth) return vec4(0.0);
     g_radiancePayload = RadiancePayload(vec4(0.0), depth + 1u);
-    traceRayEXT(g_scene, RAY_FLAG_CULL_BACK_FACING_TRIANGLES, 0xFFu, 0u, kRayTypeCount, 0u, ray.Origin, ray.TMin,
-                ray.Direction, ray.TMax, PAYLOAD_LOCATION_RADIANCE);
+    // PORT: the C++ passes 0xFF, 0, kRayTypeCount, 0: the specialization constants' defaults.
+    traceRayEXT(g_scene, RAY_FLAG_CULL_BACK_FACING_TRIANGLES, kTraceRayRadiance_InstanceMask,
+                kTraceRayRadiance_RayContribution, kTraceRayRadiance_Multiplier, kTraceRayRadiance_MissShaderIndex,
+                ray.Origin, ray.TMin, ray.Direction, ray.TMax, PAYLOAD_LOCATION_RADIANCE);
     return g_radiancePayload.color;
 }
 
@@ -140,8 +156,10 @@ bool inShadow(RayDesc ray, uint depth) {
     if (depth >= kMaxRecursionDepth) return false;
     g_shadowPayload = ShadowPayload(1u);
     traceRayEXT(g_scene,
-                RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_SKIP_CLOSEST_HIT_SHADER, 0xFFu,
-                1u, kRayTypeCount, 1u, ray.Origin, ray.TMin, ray.Direction, ray.TMax, PAYLOAD_LOCATION_SHADOW);
+                RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_SKIP_CLOSEST_HIT_SHADER,
+                kTraceRayShadow_InstanceMask, kTraceRayShadow_RayContribution, kTraceRayShadow_Multiplier,
+                kTraceRayShadow_MissShaderIndex, ray.Origin, ray.TMin, ray.Direction, ray.TMax,
+                PAYLOAD_LOCATION_SHADOW);
     return g_shadowPayload.hit != 0u;
 }
 #endif

@@ -202,10 +202,10 @@ vec4 TraceRadianceRay(in Ray ray, in uint currentRayRecursionDepth)
     g_radianceRayPayload = RayPayload(vec4(0, 0, 0, 0), currentRayRecursionDepth + 1);
     traceRayEXT(g_scene,
         RAY_FLAG_CULL_BACK_FACING_TRIANGLES,
-        TraceRayParameters_InstanceMask,
-        TraceRayParameters_HitGroup_Offset[RayType_Radiance],
-        TraceRayParameters_HitGroup_GeometryStride,
-        TraceRayParameters_MissShader_Offset[RayType_Radiance],
+        TraceRayArguments_Radiance_InstanceMask,       // PORT: TraceRayParameters_InstanceMask
+        TraceRayArguments_Radiance_RayContribution,    // PORT: TraceRayParameters_HitGroup_Offset[RayType_Radiance]
+        TraceRayArguments_Radiance_Multiplier,         // PORT: TraceRayParameters_HitGroup_GeometryStride
+        TraceRayArguments_Radiance_MissShaderIndex,    // PORT: TraceRayParameters_MissShader_Offset[RayType_Radiance]
         rayDescOrigin, rayDescTMin, rayDescDirection, rayDescTMax, PAYLOAD_LOCATION_RADIANCE);
 
     return g_radianceRayPayload.color;
@@ -236,10 +236,10 @@ bool TraceShadowRayAndReportIfHit(in Ray ray, in uint currentRayRecursionDepth)
         | RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH
         | RAY_FLAG_FORCE_OPAQUE             // ~skip any hit shaders
         | RAY_FLAG_SKIP_CLOSEST_HIT_SHADER, // ~skip closest hit shaders,
-        TraceRayParameters_InstanceMask,
-        TraceRayParameters_HitGroup_Offset[RayType_Shadow],
-        TraceRayParameters_HitGroup_GeometryStride,
-        TraceRayParameters_MissShader_Offset[RayType_Shadow],
+        TraceRayArguments_Shadow_InstanceMask,       // PORT: TraceRayParameters_InstanceMask
+        TraceRayArguments_Shadow_RayContribution,    // PORT: TraceRayParameters_HitGroup_Offset[RayType_Shadow]
+        TraceRayArguments_Shadow_Multiplier,         // PORT: TraceRayParameters_HitGroup_GeometryStride
+        TraceRayArguments_Shadow_MissShaderIndex,    // PORT: TraceRayParameters_MissShader_Offset[RayType_Shadow]
         rayDescOrigin, rayDescTMin, rayDescDirection, rayDescTMax, PAYLOAD_LOCATION_SHADOW);
 
     return g_shadowRayPayload.hit != 0u;

@@ -88,10 +88,10 @@ vec4 TraceRadianceRay(in Ray ray, in uint currentRayRecursionDepth)
     tracedRayPayload = RayPayload(color, currentRayRecursionDepth + 1u, 0.f, 0, false);
     traceRayEXT(g_scene,
         RAY_FLAG_CULL_BACK_FACING_TRIANGLES,
-        TraceRayParameters_InstanceMask,
-        TraceRayParameters_HitGroup_Offset[RayType_Radiance],
-        TraceRayParameters_HitGroup_GeometryStride,
-        TraceRayParameters_MissShader_Offset[RayType_Radiance],
+        TraceRayArguments_Radiance_InstanceMask,       // PORT: TraceRayParameters_InstanceMask
+        TraceRayArguments_Radiance_RayContribution,    // PORT: TraceRayParameters_HitGroup_Offset[RayType_Radiance]
+        TraceRayArguments_Radiance_Multiplier,         // PORT: TraceRayParameters_HitGroup_GeometryStride
+        TraceRayArguments_Radiance_MissShaderIndex,    // PORT: TraceRayParameters_MissShader_Offset[RayType_Radiance]
         rayDesc_Origin, rayDesc_TMin, rayDesc_Direction, rayDesc_TMax,
         PROCEDURAY_RADIANCE_PAYLOAD_LOCATION);
 
@@ -127,10 +127,10 @@ bool TraceShadowRayAndReportIfHit(in Ray ray, in uint currentRayRecursionDepth)
         | gl_RayFlagsTerminateOnFirstHitEXT
         | gl_RayFlagsOpaqueEXT                 // ~skip any hit shaders
         | gl_RayFlagsSkipClosestHitShaderEXT,  // ~skip closest hit shaders,
-        TraceRayParameters_InstanceMask,
-        TraceRayParameters_HitGroup_Offset[RayType_Shadow],
-        TraceRayParameters_HitGroup_GeometryStride,
-        TraceRayParameters_MissShader_Offset[RayType_Shadow],
+        TraceRayArguments_Shadow_InstanceMask,       // PORT: TraceRayParameters_InstanceMask
+        TraceRayArguments_Shadow_RayContribution,    // PORT: TraceRayParameters_HitGroup_Offset[RayType_Shadow]
+        TraceRayArguments_Shadow_Multiplier,         // PORT: TraceRayParameters_HitGroup_GeometryStride
+        TraceRayArguments_Shadow_MissShaderIndex,    // PORT: TraceRayParameters_MissShader_Offset[RayType_Shadow]
         rayDesc_Origin, rayDesc_TMin, rayDesc_Direction, rayDesc_TMax,
         PROCEDURAY_SHADOW_PAYLOAD_LOCATION);
 

@@ -64,6 +64,20 @@ const uint TraceRayParameters_MissShader_Offset[RayType_Count] = uint[](
     1u  // Shadow ray
 );
 
+// PORT: TraceRay arguments a scene overrides become specialization constants (docs/vulkan-backend.md). refray's C++
+// library takes each ray type's R, M, miss index and mask from the scene (a ray type's "traceRay", e.g. the lesson
+// scenes/lessons/multiplier-one.json); the host (gpu/vulkan_pipeline.h, traceRayConstantId) gives ray type r's
+// field f as constant_id 16 * (r + 1) + f: 0 R, 1 M, 2 miss index, 3 mask. The defaults are the HLSL's arguments,
+// so with no values given this file means the HLSL. The ray flags stay constants (a scene cannot override them).
+layout(constant_id = 16) const uint TraceRayArguments_Radiance_RayContribution = 0u;
+layout(constant_id = 17) const uint TraceRayArguments_Radiance_Multiplier = 2u;
+layout(constant_id = 18) const uint TraceRayArguments_Radiance_MissShaderIndex = 0u;
+layout(constant_id = 19) const uint TraceRayArguments_Radiance_InstanceMask = 0xFFu;  // TraceRayParameters_InstanceMask
+layout(constant_id = 32) const uint TraceRayArguments_Shadow_RayContribution = 1u;
+layout(constant_id = 33) const uint TraceRayArguments_Shadow_Multiplier = 2u;
+layout(constant_id = 34) const uint TraceRayArguments_Shadow_MissShaderIndex = 1u;
+layout(constant_id = 35) const uint TraceRayArguments_Shadow_InstanceMask = 0xFFu;
+
 const vec4 BackgroundColor = vec4(0.6f, 0.7f, 0.9f, 1.0f);
 const float InShadowRadiance = 0.35f;
 
