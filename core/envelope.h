@@ -39,6 +39,9 @@ struct Envelope {
     // class is taken over the nominal and every other render but i, and that render i moves by more than one step.
     // Empty for an envelope made before the calibration: its stable pixels get no allowance.
     std::vector<uint64_t> stableMovesLeaveOneOut;
+    // s_i, for perturbed render i: the sensitive pixels (order-dependent ones excepted) where render i falls outside
+    // the envelope of the nominal and every other render by more than one step, as a candidate is judged.
+    std::vector<uint64_t> sensitiveOutsideLeaveOneOut;
     std::map<std::string, std::string> provenance;  // settings, seeds, commit, variation model, scene SHA-256
 
     uint32_t width() const { return nominal.width(); }
@@ -89,8 +92,10 @@ struct EnvelopeJudgement {
     uint64_t stableOutside = 0, sensitiveOutside = 0, orderOutside = 0, nonFinite = 0;
     uint32_t perturbedRenders = 0;
     double outsideProbability = 0;  // per sensitive pixel, for a correct candidate: at most 2/(K+1)
-    double expectedOutside = 0;     // sensitivePixels * outsideProbability
-    uint64_t sensitiveBudget = 0;   // the most sensitive pixels outside that a correct candidate gives (1 - falseAlarm)
+    double expectedOutside = 0;     // the larger of sensitivePixels * outsideProbability and mean(s_i)
+    // The most sensitive pixels outside that a correct candidate gives (1 - falseAlarm): the larger of the binomial
+    // quantile (clusters of clusterSize) and leaveOneOutBudget(s_i).
+    uint64_t sensitiveBudget = 0;
     double expectedStableOutside = 0;  // mean(c_i): the stable pixels a correct candidate moves, by leave-one-out
     uint64_t stableBudget = 0;      // the most stable pixels a correct candidate moves (stableBudget below)
     int maxSteps = 0;
@@ -99,14 +104,15 @@ struct EnvelopeJudgement {
     std::string describe(size_t listed = 10) const;
 };
 
-// The cluster size of the stable count test: options.clusterSize, or the dispersion index of the c_i (sample
-// variance / mean: a compound Poisson count of m-pixel clusters has m) where that is larger.
-uint64_t stableClusterSize(const Envelope& envelope, const EnvelopeJudgeOptions& options);
-// The stable-pixel budget (docs/compare.md, "The stable count test"): with m = stableClusterSize and
-// T = sum over i of ceil(c_i / m)
-// clusters moved by the K leave-one-out renders, the largest y such that P(Binomial(y + T, 1/(K+1)) >= y) > falseAlarm
-// (the conditional test of a candidate's Poisson rate against the K renders'), in pixels (y * m), and at
-// least max(c_i). 0 for an envelope without the calibration.
+// The cluster size of a leave-one-out count test: options.clusterSize, or the dispersion index of the counts
+// (sample variance / mean: a compound Poisson count of m-pixel clusters has m) where that is larger.
+uint64_t leaveOneOutClusterSize(const std::vector<uint64_t>& counts, const EnvelopeJudgeOptions& options);
+// The budget of a leave-one-out count test (docs/compare.md, "The count tests"): with m = leaveOneOutClusterSize and
+// T = sum over i of ceil(c_i / m) clusters moved by the K leave-one-out renders, the largest y such that
+// P(Binomial(y + T, 1/(K+1)) >= y) > falseAlarm (the conditional test of a candidate's Poisson rate against the K
+// renders'), in pixels (y * m), and at least max(c_i). 0 for no counts.
+uint64_t leaveOneOutBudget(const std::vector<uint64_t>& counts, const EnvelopeJudgeOptions& options);
+// The stable-pixel budget: leaveOneOutBudget of envelope.stableMovesLeaveOneOut.
 uint64_t stableBudget(const Envelope& envelope, const EnvelopeJudgeOptions& options);
 
 // Judges `candidate` (quantised with floatToUnorm8) against `envelope`. Never throws for a size mismatch (the

@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/hash.h"
 #include "core/json.h"
+#include "emulator/validation.h"
 #include "scenes/scene_loader.h"
 
 namespace refray::scenes {
@@ -207,64 +208,101 @@ std::string fixed(double seconds) {
 
 }  // namespace
 
-Envelope renderEnvelope(Scene& scene, GoldenEntry& entry, const EnvelopeRenderOptions& options) {
-    const RenderSettings base = goldenSettings(entry, options.threads);
-    const auto report = [&](const std::string& what, double seconds) {
-        if (options.onRender) options.onRender(what, seconds);
-    };
-    std::vector<Image> variants;
-    std::string perturbations;
-    double perturbedSeconds = 0.0;
-
-    // The nominal render and the order check (its adversarial orders are variants too).
-    auto start = std::chrono::steady_clock::now();
-    OrderCheckResult check = checkTraversalOrder(scene, base, 0);
-    const double nominalSeconds = secondsSince(start);
-    report("nominal", nominalSeconds);
-    start = std::chrono::steady_clock::now();
-    {
+std::vector<EnvelopePart> envelopeParts(const GoldenEntry& entry, uint32_t threads) {
+    const RenderSettings base = goldenSettings(entry, threads);
+    std::vector<EnvelopePart> parts;
+    parts.push_back({"nominal", base});
+    for (uint32_t seed = 1; seed <= entry.orders; ++seed) {
         RenderSettings s = base;
         s.order = dxr::TraversalOrder::Adversarial;
-        Image mask(entry.width, entry.height, vec4(0.0f, 0.0f, 0.0f, 1.0f));
-        for (uint32_t seed = 1; seed <= entry.orders; ++seed) {
-            s.adversarialSeed = seed;
-            Image other = scene.render(s).image;
-            for (size_t i = 0; i < other.pixels().size(); ++i)
-                if (std::memcmp(&other.pixels()[i], &check.ordered.image.pixels()[i], sizeof(vec4)) != 0)
-                    mask.pixels()[i] = vec4(1.0f);
-            variants.push_back(std::move(other));
-        }
-        check.mask = std::move(mask);
+        s.adversarialSeed = seed;
+        parts.push_back({"order-" + std::to_string(seed), s});
     }
-    const double orderSeconds = secondsSince(start);
-    if (entry.orders) report(std::to_string(entry.orders) + " adversarial orders", orderSeconds);
-
-    // K legal GPUs of the variation model, then double precision.
     for (uint32_t seed = 1; seed <= entry.perturbedRenders; ++seed) {
-        start = std::chrono::steady_clock::now();
         RenderSettings s = base;
         s.perturbation = goldenPerturbation(seed);
-        variants.push_back(scene.render(s).image);
-        perturbations += (perturbations.empty() ? "" : "; ") + procedural::describe(*s.perturbation);
-        const double seconds = secondsSince(start);
-        perturbedSeconds += seconds;
-        report("perturbed seed " + std::to_string(seed), seconds);
+        parts.push_back({"perturbed-" + std::to_string(seed), s});
     }
-    start = std::chrono::steady_clock::now();
-    {
-        RenderSettings s = base;
-        s.precision = procedural::Precision::Double;
-        variants.push_back(scene.render(s).image);
-    }
-    const double doubleSeconds = secondsSince(start);
-    report("double", doubleSeconds);
+    RenderSettings s = base;
+    s.precision = procedural::Precision::Double;
+    parts.push_back({"double", s});
+    return parts;
+}
 
+Image renderEnvelopePart(Scene& scene, const EnvelopePart& part) {
+    if (!part.settings.perturbation) return scene.render(part.settings).image;
+    RenderSettings s = part.settings;
+    const uint32_t seed = uint32_t(s.perturbation->seed);
+    std::string reached;
+    for (uint32_t attempt = 0; attempt < kPerturbedSeedAttempts; ++attempt) {
+        s.perturbation = goldenPerturbation(seed + attempt * kPerturbedSeedStride);
+        try {
+            Image image = scene.render(s).image;
+            image.metadata["golden_part_seed"] = std::to_string(s.perturbation->seed);
+            return image;
+        } catch (const dxr::DxrError& e) {
+            reached += std::string("\n  seed ") + std::to_string(s.perturbation->seed) + ": " + e.what();
+        }
+    }
+    REFRAY_CHECK(false, "every legal GPU tried for " << part.name << " reaches undefined behaviour:" << reached);
+    return {};
+}
+
+Envelope renderEnvelope(Scene& scene, GoldenEntry& entry, const EnvelopeRenderOptions& options) {
+    std::map<std::string, Image> renders;
+    std::map<std::string, double> seconds;
+    for (const EnvelopePart& part : envelopeParts(entry, options.threads)) {
+        const auto start = std::chrono::steady_clock::now();
+        renders[part.name] = renderEnvelopePart(scene, part);
+        seconds[part.name] = secondsSince(start);
+        if (options.onRender) options.onRender(part.name, seconds[part.name]);
+    }
+    return assembleEnvelope(entry, renders, seconds);
+}
+
+Envelope assembleEnvelope(GoldenEntry& entry, const std::map<std::string, Image>& renders,
+                          const std::map<std::string, double>& seconds) {
+    const auto render = [&](const std::string& name) -> const Image& {
+        const auto found = renders.find(name);
+        REFRAY_CHECK(found != renders.end(), "the envelope of " << entry.name << " lacks its render '" << name << "'");
+        REFRAY_CHECK(found->second.width() == entry.width && found->second.height() == entry.height,
+                     "the render '" << name << "' of " << entry.name << " is " << found->second.width() << "x"
+                                    << found->second.height() << ", the golden " << entry.width << "x" << entry.height);
+        return found->second;
+    };
+    const auto total = [&](const std::string& prefix) {
+        double sum = 0;
+        for (const auto& [name, t] : seconds)
+            if (name.rfind(prefix, 0) == 0) sum += t;
+        return sum;
+    };
+    const Image& nominal = render("nominal");
+    // The order mask: where an adversarial order changes the pixel's bits.
+    Image mask(entry.width, entry.height, vec4(0.0f, 0.0f, 0.0f, 1.0f));
+    std::vector<const Image*> orders, perturbed;
+    for (uint32_t seed = 1; seed <= entry.orders; ++seed) {
+        const Image& other = render("order-" + std::to_string(seed));
+        for (size_t i = 0; i < other.pixels().size(); ++i)
+            if (std::memcmp(&other.pixels()[i], &nominal.pixels()[i], sizeof(vec4)) != 0) mask.pixels()[i] = vec4(1.0f);
+        orders.push_back(&other);
+    }
+    std::string perturbations;
+    std::string seedsUsed;
+    for (uint32_t seed = 1; seed <= entry.perturbedRenders; ++seed) {
+        const Image& image = render("perturbed-" + std::to_string(seed));
+        perturbed.push_back(&image);
+        const auto used = image.metadata.find("golden_part_seed");
+        const uint32_t actual = used == image.metadata.end() ? seed : uint32_t(std::stoul(used->second));
+        perturbations += (perturbations.empty() ? "" : "; ") + procedural::describe(goldenPerturbation(actual));
+        seedsUsed += (seedsUsed.empty() ? "" : " ") + std::to_string(actual);
+    }
     // makeEnvelope counts the first `perturbedRenders` variants as the exchangeable ones; order them so.
-    std::vector<const Image*> pointers;
-    for (size_t i = entry.orders; i < entry.orders + entry.perturbedRenders; ++i) pointers.push_back(&variants[i]);
-    for (size_t i = 0; i < entry.orders; ++i) pointers.push_back(&variants[i]);
-    pointers.push_back(&variants.back());
-    Envelope envelope = makeEnvelope(check.ordered.image, pointers, entry.perturbedRenders, &check.mask);
+    std::vector<const Image*> pointers = perturbed;
+    pointers.insert(pointers.end(), orders.begin(), orders.end());
+    pointers.push_back(&render("double"));
+    Envelope envelope = makeEnvelope(nominal, pointers, entry.perturbedRenders, &mask);
+    const double nominalSeconds = total("nominal"), orderSeconds = total("order-"),
+                 perturbedSeconds = total("perturbed-"), doubleSeconds = total("double");
 
     entry.orderDependentPixels = 0;
     for (uint8_t o : envelope.orderDependent) entry.orderDependentPixels += o;
@@ -280,32 +318,28 @@ Envelope renderEnvelope(Scene& scene, GoldenEntry& entry, const EnvelopeRenderOp
     p["size"] = std::to_string(entry.width) + "x" + std::to_string(entry.height);
     p["refray_commit"] = entry.refrayCommit;
     p["variation_model"] = entry.variationModel;
-    p["perturbed_seeds"] = entry.perturbedRenders ? "1.." + std::to_string(entry.perturbedRenders) : "none";
+    // Seed k, or k + 100, k + 200, ... where seed k's legal GPU reaches undefined behaviour (renderEnvelopePart).
+    p["perturbed_seeds"] = entry.perturbedRenders ? seedsUsed : "none";
     p["perturbations"] = perturbations;
     p["order_check_orders"] = std::to_string(entry.orders);
     p["order_dependent_pixels"] = std::to_string(entry.orderDependentPixels);
     p["sensitive_pixels"] = std::to_string(entry.sensitivePixels);
-    {
-        std::string moves;
-        for (uint64_t c : envelope.stableMovesLeaveOneOut) {
-            if (!moves.empty()) moves += ' ';
-            moves += std::to_string(c);
-        }
-        p["stable_moves_loo"] = moves;  // also refray:envelope_stable_moves_loo, which the compare reads
-        p["stable_budget"] = std::to_string(stableBudget(envelope, {}));
-        const uint64_t m = stableClusterSize(envelope, {});
-        p["stable_cluster_size"] = std::to_string(m);
-        p["stable_budget_rule"] = "clusters of m = max(9, ceil(var(c_i)/mean(c_i))) pixels; m times the largest y with "
-                                  "P(Binomial(y + T, 1/(K+1)) >= y) > 1e-3, T = sum ceil(c_i/m); at least max(c_i); "
-                                  "docs/compare.md";
-    }
+    // The count tests' calibration is in refray:envelope_stable_moves_loo and refray:envelope_sensitive_outside_loo,
+    // which the compare reads; what it makes of them, for a reader of the file:
+    p["stable_budget"] = std::to_string(stableBudget(envelope, {}));
+    p["stable_cluster_size"] = std::to_string(leaveOneOutClusterSize(envelope.stableMovesLeaveOneOut, {}));
+    p["sensitive_loo_budget"] = std::to_string(leaveOneOutBudget(envelope.sensitiveOutsideLeaveOneOut, {}));
+    p["sensitive_cluster_size"] = std::to_string(leaveOneOutClusterSize(envelope.sensitiveOutsideLeaveOneOut, {}));
+    p["count_test_rule"] = "clusters of m = max(9, ceil(var(c_i)/mean(c_i))) pixels; m times the largest y with "
+                           "P(Binomial(y + T, 1/(K+1)) >= y) > 1e-3, T = sum ceil(c_i/m); at least max(c_i); the "
+                           "sensitive budget is also at least the binomial 1e-3 quantile of 2/(K+1); docs/compare.md";
     p["other_variants"] = "precision double; adversarial orders 1.." + std::to_string(entry.orders);
     p["render_seconds_nominal"] = fixed(nominalSeconds);
     p["render_seconds_perturbed"] = fixed(perturbedSeconds);
     p["render_seconds_double"] = fixed(doubleSeconds);
     p["render_seconds_orders"] = fixed(orderSeconds);
     // The nominal render's own metadata (scene, camera, ...) stays on the nominal; the envelope's keys win.
-    for (const auto& [key, value] : check.ordered.image.metadata) p.try_emplace(key, value);
+    for (const auto& [key, value] : nominal.metadata) p.try_emplace(key, value);
     envelope.nominal.metadata.clear();
     return envelope;
 }
@@ -335,72 +369,204 @@ GoldenEntry entryFor(const SceneDesc& desc, const fs::path& file, const fs::path
 
 }  // namespace
 
-GoldenEntry makeGolden(const GoldenMakeOptions& options) {
-    Scene scene(loadSceneFile(options.sceneFile));
-    const SceneDesc& desc = scene.desc();
-    REFRAY_CHECK(!isMonteCarlo(desc), options.sceneFile.string()
-                                          << " is a Monte Carlo scene: it gets a statistical golden (docs/compare.md), "
-                                             "not an envelope");
-    const CameraDesc& camera = options.camera.empty() ? desc.cameras.at(0) : desc.camera(options.camera);
-    GoldenEntry e = entryFor(desc, options.sceneFile, options.repositoryRoot, camera, options.time, options.width,
-                             options.height, options.orders, options.perturbedRenders, options.refrayCommit);
-    fs::create_directories(options.goldenDirectory);
-    const Envelope envelope = renderEnvelope(scene, e, options.render);
-    writeEnvelope((options.goldenDirectory / e.envelope).string(), envelope);
+namespace {
 
-    const fs::path manifest = options.goldenDirectory / "goldens.json";
+GoldenSet existingSet(const fs::path& manifest) {
     GoldenSet set;
-    if (fs::exists(manifest)) set = readGoldenManifest(manifest);
+    if (!fs::exists(manifest)) return set;
+    // The statistical entries are kept; an older manifest's are read by hand so that an update converts it.
+    try {
+        set = readGoldenManifest(manifest);
+    } catch (const Error&) {
+        set.statistical = readStatisticalEntries(manifest);
+    }
+    return set;
+}
+
+// Writes an entry's envelope; with `replaceAll` (update) the set's entries are this run's, otherwise (make) the
+// entry replaces the one of its name.
+void addEntry(GoldenSet& set, const fs::path& directory, const GoldenEntry& e, const Envelope& envelope) {
+    writeEnvelope((directory / e.envelope).string(), envelope);
+    // The files of the older format (a plain golden and its order mask) are replaced by the envelope.
+    fs::remove(directory / (e.name + ".exr"));
+    fs::remove(directory / (e.name + ".order-mask.png"));
     std::erase_if(set.entries, [&](const GoldenEntry& other) { return other.name == e.name; });
     set.entries.push_back(e);
+}
+
+const char* const kPlanMode[] = {"make", "update"};
+
+}  // namespace
+
+GoldenEntry makeGolden(const GoldenMakeOptions& options) {
+    GoldenEntry e = planMake(options);
+    Scene scene(loadSceneFile(options.sceneFile));
+    fs::create_directories(options.goldenDirectory);
+    const Envelope envelope = renderEnvelope(scene, e, options.render);
+    const fs::path manifest = options.goldenDirectory / "goldens.json";
+    GoldenSet set = existingSet(manifest);
+    addEntry(set, options.goldenDirectory, e, envelope);
     writeGoldenManifest(manifest, set);
     return e;
 }
 
-GoldenSet updateGoldens(const GoldenUpdateOptions& options) {
+void writeGoldenPlan(const fs::path& goldenDirectory, const std::vector<GoldenEntry>& entries, bool update) {
+    const fs::path jobs = goldenDirectory / "jobs";
+    fs::create_directories(jobs);
+    GoldenSet plan;
+    plan.entries = entries;
+    writeGoldenManifest(jobs / "plan.json", plan);
+    std::ofstream mode(jobs / "mode");
+    REFRAY_CHECK(mode << kPlanMode[update] << "\n", "cannot write " << (jobs / "mode").string());
+}
+
+std::vector<std::string> goldenJobCommands(const fs::path& goldenDirectory, const fs::path& repositoryRoot,
+                                           const std::string& refray) {
+    const GoldenSet plan = readGoldenManifest(goldenDirectory / "jobs" / "plan.json");
+    const auto quote = [](const std::string& text) {
+        std::string q = "'";
+        for (char c : text) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+        return q + "'";
+    };
+    std::vector<std::string> lines;
+    for (const GoldenEntry& e : plan.entries)
+        for (const EnvelopePart& part : envelopeParts(e, 0))
+            lines.push_back(quote(refray) + " golden job " + quote(fs::absolute(goldenDirectory).string()) + " " +
+                            quote(e.name) + " " + part.name + " --root " + quote(fs::absolute(repositoryRoot).string()) +
+                            " --threads 1");
+    return lines;
+}
+
+fs::path goldenJobOutput(const fs::path& goldenDirectory, const std::string& name, const std::string& part) {
+    return goldenDirectory / "jobs" / name / (part + ".exr");
+}
+
+void runGoldenJob(const fs::path& goldenDirectory, const fs::path& repositoryRoot, const std::string& name,
+                  const std::string& part, uint32_t threads) {
+    const fs::path planFile = goldenDirectory / "jobs" / "plan.json";
+    REFRAY_CHECK(fs::exists(planFile), goldenDirectory.string() << " holds no golden plan (no jobs/plan.json); write "
+                                                                   "one with 'refray golden update --emit-jobs FILE'");
+    const GoldenSet plan = readGoldenManifest(planFile);
+    const auto entry = std::find_if(plan.entries.begin(), plan.entries.end(),
+                                    [&](const GoldenEntry& e) { return e.name == name; });
+    REFRAY_CHECK(entry != plan.entries.end(), "the plan " << planFile.string() << " has no golden '" << name << "'");
+    const std::vector<EnvelopePart> parts = envelopeParts(*entry, threads);
+    const auto p = std::find_if(parts.begin(), parts.end(), [&](const EnvelopePart& x) { return x.name == part; });
+    REFRAY_CHECK(p != parts.end(), "golden '" << name << "' has no render '" << part << "' (it has nominal, order-1.."
+                                              << entry->orders << ", perturbed-1.." << entry->perturbedRenders
+                                              << ", double)");
+    Scene scene(loadSceneFile(repositoryRoot / entry->scene));
+    REFRAY_CHECK(scene.desc().fileHash == entry->sceneSha256,
+                 (repositoryRoot / entry->scene).string() << " changed since the plan was written (SHA-256 "
+                                                          << scene.desc().fileHash << ", planned " << entry->sceneSha256
+                                                          << "); write the plan again");
+    const auto start = std::chrono::steady_clock::now();
+    Image image = renderEnvelopePart(scene, *p);
+    image.metadata["golden_job_seconds"] = fixed(secondsSince(start));
+    const fs::path out = goldenJobOutput(goldenDirectory, name, part);
+    fs::create_directories(out.parent_path());
+    // Written under a temporary name and renamed: a job killed half-way leaves no file that looks finished.
+    const fs::path partial = out.parent_path() / (part + ".partial.exr");
+    writeImage(partial.string(), image);
+    fs::rename(partial, out);
+}
+
+GoldenSet collectGoldens(const fs::path& goldenDirectory, const std::function<void(const GoldenEntry&)>& onEntry) {
+    const fs::path jobs = goldenDirectory / "jobs";
+    REFRAY_CHECK(fs::exists(jobs / "plan.json"), goldenDirectory.string() << " holds no golden plan (no jobs/plan.json)");
+    const GoldenSet plan = readGoldenManifest(jobs / "plan.json");
+    std::ifstream modeFile(jobs / "mode");
+    std::string mode;
+    modeFile >> mode;
+    REFRAY_CHECK(mode == kPlanMode[0] || mode == kPlanMode[1], (jobs / "mode").string() << " says '" << mode
+                                                                  << "', not 'make' or 'update'");
+    // Every render first: a missing one is named with the line that makes it, before anything is written.
+    std::vector<std::string> missing;
+    for (const GoldenEntry& e : plan.entries)
+        for (const EnvelopePart& part : envelopeParts(e, 0))
+            if (!fs::exists(goldenJobOutput(goldenDirectory, e.name, part.name)))
+                missing.push_back(e.name + " " + part.name);
+    if (!missing.empty()) {
+        std::string list;
+        for (size_t i = 0; i < missing.size() && i < 10; ++i) list += "\n  refray golden job DIR " + missing[i];
+        REFRAY_CHECK(false, missing.size() << " of the plan's renders are missing in " << jobs.string()
+                                           << " (a job that failed or has not run); run them:" << list
+                                           << (missing.size() > 10 ? "\n  ..." : ""));
+    }
+    const fs::path manifest = goldenDirectory / "goldens.json";
+    GoldenSet set = existingSet(manifest);
+    if (mode == "update") set.entries.clear();
+    for (GoldenEntry e : plan.entries) {
+        std::map<std::string, Image> renders;
+        std::map<std::string, double> seconds;
+        for (const EnvelopePart& part : envelopeParts(e, 0)) {
+            Image image = readImage(goldenJobOutput(goldenDirectory, e.name, part.name).string());
+            const auto t = image.metadata.find("golden_job_seconds");
+            seconds[part.name] = t == image.metadata.end() ? 0.0 : std::stod(t->second);
+            if (t != image.metadata.end()) image.metadata.erase(t);
+            renders[part.name] = std::move(image);
+        }
+        const Envelope envelope = assembleEnvelope(e, renders, seconds);
+        addEntry(set, goldenDirectory, e, envelope);
+        if (onEntry) onEntry(e);
+    }
+    writeGoldenManifest(manifest, set);
+    return set;
+}
+
+std::vector<GoldenEntry> planUpdate(const GoldenUpdateOptions& options) {
     std::vector<fs::path> files;
     for (const auto& f : fs::directory_iterator(options.repositoryRoot / "scenes"))
         if (f.is_regular_file() && f.path().extension() == ".json") files.push_back(f.path());
     std::sort(files.begin(), files.end());
     REFRAY_CHECK(!files.empty(), "no scene files in " << (options.repositoryRoot / "scenes").string());
-    fs::create_directories(options.goldenDirectory);
-
-    GoldenSet set;
-    const fs::path manifest = options.goldenDirectory / "goldens.json";
-    if (fs::exists(manifest)) {
-        // The statistical entries are kept; an older manifest's are read by hand so that an update converts it.
-        try {
-            set.statistical = readGoldenManifest(manifest).statistical;
-        } catch (const Error&) {
-            set.statistical = readStatisticalEntries(manifest);
-        }
-    }
+    std::vector<GoldenEntry> entries;
     for (const fs::path& file : files) {
-        Scene scene(loadSceneFile(file));
-        const SceneDesc& desc = scene.desc();
-        if (isMonteCarlo(desc)) continue;  // statistical goldens only (below)
-        for (const CameraDesc& camera : desc.cameras) {
-            const auto start = std::chrono::steady_clock::now();
-            GoldenEntry e = entryFor(desc, file, options.repositoryRoot, camera, "", options.width, options.height,
-                                     options.orders, options.perturbedRenders, options.refrayCommit);
-            EnvelopeRenderOptions render;
-            render.threads = options.threads;
-            render.onRender = options.onRender;
-            const Envelope envelope = renderEnvelope(scene, e, render);
-            writeEnvelope((options.goldenDirectory / e.envelope).string(), envelope);
-            // The files of the older format (a plain golden and its order mask) are replaced by the envelope.
-            fs::remove(options.goldenDirectory / (e.name + ".exr"));
-            fs::remove(options.goldenDirectory / (e.name + ".order-mask.png"));
-            set.entries.push_back(e);
-            if (options.onEntry) options.onEntry(e, secondsSince(start));
-        }
+        const SceneDesc desc = loadSceneFile(file);
+        if (isMonteCarlo(desc)) continue;  // statistical goldens only
+        for (const CameraDesc& camera : desc.cameras)
+            entries.push_back(entryFor(desc, file, options.repositoryRoot, camera, "", options.width, options.height,
+                                       options.orders, options.perturbedRenders, options.refrayCommit));
+    }
+    return entries;
+}
+
+GoldenEntry planMake(const GoldenMakeOptions& options) {
+    const SceneDesc desc = loadSceneFile(options.sceneFile);
+    REFRAY_CHECK(!isMonteCarlo(desc), options.sceneFile.string()
+                                          << " is a Monte Carlo scene: it gets a statistical golden (docs/compare.md), "
+                                             "not an envelope");
+    const CameraDesc& camera = options.camera.empty() ? desc.cameras.at(0) : desc.camera(options.camera);
+    return entryFor(desc, options.sceneFile, options.repositoryRoot, camera, options.time, options.width,
+                    options.height, options.orders, options.perturbedRenders, options.refrayCommit);
+}
+
+
+GoldenSet updateGoldens(const GoldenUpdateOptions& options) {
+    const std::vector<GoldenEntry> planned = planUpdate(options);
+    fs::create_directories(options.goldenDirectory);
+    const fs::path manifest = options.goldenDirectory / "goldens.json";
+    GoldenSet set;
+    set.statistical = existingSet(manifest).statistical;
+    std::unique_ptr<Scene> scene;
+    for (GoldenEntry e : planned) {
+        const auto start = std::chrono::steady_clock::now();
+        if (!scene || scene->desc().fileHash != e.sceneSha256 ||
+            fs::path(scene->desc().file).filename() != fs::path(e.scene).filename())
+            scene = std::make_unique<Scene>(loadSceneFile(options.repositoryRoot / e.scene));
+        EnvelopeRenderOptions render;
+        render.threads = options.threads;
+        render.onRender = options.onRender;
+        const Envelope envelope = renderEnvelope(*scene, e, render);
+        addEntry(set, options.goldenDirectory, e, envelope);
+        if (options.onEntry) options.onEntry(e, secondsSince(start));
     }
     for (StatisticalGoldenEntry& e : set.statistical) {
         const auto start = std::chrono::steady_clock::now();
-        Scene scene(loadSceneFile(options.repositoryRoot / e.scene));
-        e.sceneSha256 = scene.desc().fileHash;
+        Scene statisticalScene(loadSceneFile(options.repositoryRoot / e.scene));
+        e.sceneSha256 = statisticalScene.desc().fileHash;
         e.refrayCommit = options.refrayCommit;
-        StatisticsImage stats = renderStatistics(scene, e, e.seed, e.batches, options.threads);
+        StatisticsImage stats = renderStatistics(statisticalScene, e, e.seed, e.batches, options.threads);
         stats.mean.metadata["refray_commit"] = options.refrayCommit;
         writeStatisticsImage((options.goldenDirectory / e.image).string(), stats);
         if (options.onStatisticalEntry) {

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -98,6 +99,24 @@ struct EnvelopeRenderOptions {
 // model, scene SHA-256 and the seconds each kind of render took.
 Envelope renderEnvelope(Scene& scene, GoldenEntry& entry, const EnvelopeRenderOptions& options);
 
+// The renders an envelope is made of, each independent of the others: "nominal", "order-1".."order-N" (adversarial
+// orders), "perturbed-1".."perturbed-K" and "double", with their settings.
+struct EnvelopePart {
+    std::string name;
+    RenderSettings settings;
+};
+std::vector<EnvelopePart> envelopeParts(const GoldenEntry& entry, uint32_t threads);
+// Renders one part. A perturbed part k is the legal GPU of seed k; where that GPU's arithmetic reaches undefined
+// behaviour (a dxr::DxrError: e.g. acos of a quotient 2.5 ulp above 1 gives NaN, and a ray with a NaN direction is
+// UB, RAY-5) the part takes seed k + 100, then k + 200, ... (kPerturbedSeedAttempts in all; the image's metadata
+// golden_part_seed names the seed used). Deterministic: the same part always gets the same seed.
+inline constexpr uint32_t kPerturbedSeedStride = 100, kPerturbedSeedAttempts = 5;
+Image renderEnvelopePart(Scene& scene, const EnvelopePart& part);
+// The envelope of the parts' renders (by part name; seconds by part name, for the provenance): what renderEnvelope
+// does after rendering. Throws refray::Error naming a missing part or one of another size.
+Envelope assembleEnvelope(GoldenEntry& entry, const std::map<std::string, Image>& renders,
+                          const std::map<std::string, double>& seconds);
+
 // `refray golden make`: the envelope golden of one scene file, camera, time and size, written as
 // <directory>/<scene name>.<camera>.envelope.exr and added to (or replaced in) <directory>/goldens.json.
 struct GoldenMakeOptions {
@@ -132,5 +151,25 @@ struct GoldenUpdateOptions {
 // (isMonteCarlo) get no threshold golden: the statistical entries of the existing manifest are kept, each
 // re-rendered with its own settings (size, spp, batches, seed; `width`/`height` above do not apply).
 GoldenSet updateGoldens(const GoldenUpdateOptions& options);
+
+// The entries updateGoldens and makeGolden would make, without rendering.
+std::vector<GoldenEntry> planUpdate(const GoldenUpdateOptions& options);
+GoldenEntry planMake(const GoldenMakeOptions& options);
+
+// The distributed form (--emit-jobs, --collect; README "Goldens on a cluster"). Every render of an envelope is one
+// job: writeGoldenPlan stores the entries in <dir>/jobs/plan.json (and whether they are an update, which replaces
+// the set's envelope entries, or a make, which adds to them); goldenJobCommands gives one command line per render
+// ("REFRAY golden job DIR NAME PART"); runGoldenJob renders one into <dir>/jobs/<name>/<part>.exr; collectGoldens
+// assembles the envelopes and the manifest from them, bit-identical to the in-process run but for the
+// render_seconds_* provenance. Statistical goldens are not planned: an update keeps them as they are.
+void writeGoldenPlan(const std::filesystem::path& goldenDirectory, const std::vector<GoldenEntry>& entries,
+                     bool update);
+std::vector<std::string> goldenJobCommands(const std::filesystem::path& goldenDirectory,
+                                           const std::filesystem::path& repositoryRoot, const std::string& refray);
+void runGoldenJob(const std::filesystem::path& goldenDirectory, const std::filesystem::path& repositoryRoot,
+                  const std::string& name, const std::string& part, uint32_t threads);
+// Throws refray::Error listing the missing renders (and the lines that make them) before writing anything.
+GoldenSet collectGoldens(const std::filesystem::path& goldenDirectory,
+                         const std::function<void(const GoldenEntry&)>& onEntry);
 
 }  // namespace refray::scenes

@@ -83,12 +83,12 @@ TEST(Envelope, CalibratesTheStableBudgetByLeaveOneOut) {
     // The c_i scatter more than 9-pixel clusters allow: mean 31/3, sample variance 290.3, so clusters of
     // ceil(290.3 / 10.33) = 29; T = ceil(30/29) + ceil(1/29) = 3 clusters; p = 1/4: the largest y with
     // P(Binomial(y + 3, 1/4) >= y) > 1e-3 is 8, so 8 x 29 pixels.
-    EXPECT_EQ(stableClusterSize(e, {}), 29u);
+    EXPECT_EQ(leaveOneOutClusterSize(e.stableMovesLeaveOneOut, {}), 29u);
     EXPECT_EQ(stableBudget(e, {}), 232u);
     // Counts as even as Poisson 9-pixel clusters keep the cluster size of the options.
     Envelope even = e;
     even.stableMovesLeaveOneOut = {20, 21, 22};
-    EXPECT_EQ(stableClusterSize(even, {}), 9u);
+    EXPECT_EQ(leaveOneOutClusterSize(even.stableMovesLeaveOneOut, {}), 9u);
 
     const std::filesystem::path dir = std::filesystem::path(REFRAY_TEST_OUTPUT_DIR) / "envelope";
     std::filesystem::create_directories(dir);
