@@ -399,7 +399,8 @@ EnvelopeJudgement judgeEnvelope(const Envelope& e, const Image& candidate, const
             j.sensitiveBudget = std::min<uint64_t>(j.sensitivePixels, uint64_t(q) * options.clusterSize);
         }
     }
-    j.sensitiveBudget = std::max(j.sensitiveBudget, leaveOneOutBudget(e.sensitiveOutsideLeaveOneOut, options));
+    j.sensitiveBudget = std::min(j.sensitivePixels,
+                                 std::max(j.sensitiveBudget, leaveOneOutBudget(e.sensitiveOutsideLeaveOneOut, options)));
     if (!e.sensitiveOutsideLeaveOneOut.empty()) {
         uint64_t total = 0;
         for (uint64_t c : e.sensitiveOutsideLeaveOneOut) total += c;

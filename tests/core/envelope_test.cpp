@@ -109,6 +109,34 @@ TEST(Envelope, SensitivePixelsOutsideAreCountedAgainstTheBinomialBudget) {
     EXPECT_EQ(j.verdict, CompareVerdict::Warn);  // within the budget, above the expected 2/9 pixel
 }
 
+// s_i: the sensitive pixels where perturbed render i lies more than one step outside the bounds of every other render
+// (the nominal and the non-perturbed variants included), as a candidate is judged; the sensitive budget is the larger
+// of the binomial one and the leave-one-out one, capped at the sensitive pixels.
+TEST(Envelope, CalibratesTheSensitiveBudgetByLeaveOneOut) {
+    const Image nominal = flat(20, 20, 100);
+    std::vector<Image> variants(4, nominal);  // 3 perturbed + double
+    for (uint32_t i = 0; i < 40; ++i) {
+        variants[0].at(i % 20, i / 20).r = 150.0f / 255.0f;  // far above the others
+        variants[1].at(i % 20, i / 20).r = 95.0f / 255.0f;   // below the others by more than one step
+        variants[2].at(i % 20, i / 20).r = 105.0f / 255.0f;  // inside [95, 150]
+    }
+    variants[3].at(0, 10).r = 110.0f / 255.0f;  // the double render alone: sensitive, but no perturbed render outside
+    std::vector<const Image*> pointers;
+    for (const Image& v : variants) pointers.push_back(&v);
+    const Envelope e = makeEnvelope(nominal, pointers, 3, nullptr);
+    EXPECT_EQ(e.sensitivePixels(), 41u);
+    EXPECT_EQ(e.sensitiveOutsideLeaveOneOut, (std::vector<uint64_t>{40, 40, 0}));
+    const EnvelopeJudgement j = judgeEnvelope(e, nominal, {});
+    EXPECT_EQ(j.sensitiveBudget, std::min<uint64_t>(41, leaveOneOutBudget(e.sensitiveOutsideLeaveOneOut, {})));
+    EXPECT_NEAR(j.expectedOutside, 80.0 / 3.0, 1e-9);  // the leave-one-out mean exceeds 41 x 2/4
+
+    const std::filesystem::path dir = std::filesystem::path(REFRAY_TEST_OUTPUT_DIR) / "envelope";
+    std::filesystem::create_directories(dir);
+    const std::string path = (dir / "sensitive-loo.envelope.exr").string();
+    writeEnvelope(path, e);
+    EXPECT_EQ(readEnvelope(path).sensitiveOutsideLeaveOneOut, e.sensitiveOutsideLeaveOneOut);
+}
+
 TEST(Envelope, NaNAlwaysFailsAndOrderPixelsAreReportedApart) {
     const Image nominal = flat(4, 4, 50);
     Image mask(4, 4, vec4(0.0f, 0.0f, 0.0f, 1.0f));
