@@ -483,161 +483,17 @@ int main(int argc, char** argv) {
     refray::tools::ExplainCommandOptions explainOptions;
     CLI::App* explain = refray::tools::addExplainCommand(app, explainOptions);
 
-    auto* golden = app.add_subcommand("golden", "Golden images of every scene x camera (tests/golden/)");
-    golden->require_subcommand(1);
-    auto* update = golden->add_subcommand("update", "Re-render the envelope golden of every scene x camera and the "
-                                                    "manifest (docs/golden-format.md)");
-    std::string goldenDir = "tests/golden", goldenSize = "320x180", repositoryRoot = ".";
-    uint32_t goldenOrders = 4, goldenThreads = 0, goldenPerturbed = scenes::kDefaultPerturbedRenders;
-    update->add_option("--perturbed", goldenPerturbed, "Perturbed renders per golden (K: seeds 1..K)")
-        ->check(tools::wholeNumber("a number of perturbed renders"))
-        ->capture_default_str();
-    update->add_option("--dir", goldenDir, "Where the goldens go")->capture_default_str();
-    update->add_option("--root", repositoryRoot, "The repository root (holds scenes/)")->capture_default_str();
-    update->add_option("--size", goldenSize, "Golden size WIDTHxHEIGHT")->capture_default_str();
-    update->add_option("--order-check", goldenOrders, "Adversarial orders per golden")
-        ->check(tools::wholeNumber("a number of adversarial orders per golden"))
-        ->capture_default_str();
-    std::string updateEmitJobs, makeEmitJobs;
-    bool updateCollect = false, makeCollect = false;
-    update->add_option("--emit-jobs", updateEmitJobs,
-                       "Plan only: write one command line per render to FILE (for GNU parallel or a Slurm array); "
-                       "then 'refray golden update --collect'");
-    update->add_flag("--collect", updateCollect, "Assemble the goldens from the renders the --emit-jobs lines wrote");
-    update->add_option("--threads", goldenThreads, "Worker threads (0: all)")
-        ->check(tools::threadCount())
-        ->capture_default_str();
-
-    auto* make = golden->add_subcommand("make", "Render the envelope golden of one scene, camera, time and size into a "
-                                                "golden directory");
-    std::string makeScene, makeCamera, makeTime, makeSize = "320x180", makeDir;
-    uint32_t makeOrders = 4, makePerturbed = scenes::kDefaultPerturbedRenders, makeThreads = 0;
-    make->add_option("scene", makeScene, "Scene file (not with --collect)");
-    make->add_option("--camera", makeCamera, "Camera (default: the scene's first)");
-    make->add_option("--time", makeTime, "Time in seconds (default: the scene's)");
-    make->add_option("--size", makeSize, "WIDTHxHEIGHT")->capture_default_str();
-    make->add_option("-o,--dir", makeDir, "The golden directory (goldens.json is created or extended)")->required();
-    make->add_option("--root", repositoryRoot, "The repository root: scene paths in the manifest are relative to it")
-        ->capture_default_str();
-    make->add_option("--order-check", makeOrders, "Adversarial orders")
-        ->check(tools::wholeNumber("a number of adversarial orders"))
-        ->capture_default_str();
-    make->add_option("--perturbed", makePerturbed, "Perturbed renders (K: seeds 1..K)")
-        ->check(tools::wholeNumber("a number of perturbed renders"))
-        ->capture_default_str();
-    make->add_option("--threads", makeThreads, "Worker threads (0: all)")->check(tools::threadCount());
-    make->add_option("--emit-jobs", makeEmitJobs,
-                     "Plan only: write one command line per render to FILE; then 'refray golden make --collect -o DIR'");
-    make->add_flag("--collect", makeCollect, "Assemble the golden from the renders the --emit-jobs lines wrote");
-    auto* job = golden->add_subcommand("job", "Render one render of a planned golden (what --emit-jobs lines run)");
-    std::string jobDir, jobName, jobPart;
-    uint32_t jobThreads = 0;
-    job->add_option("dir", jobDir, "The golden directory holding jobs/plan.json")->required();
-    job->add_option("name", jobName, "The golden's name")->required();
-    job->add_option("part", jobPart, "nominal, order-N, perturbed-N or double")->required();
-    job->add_option("--root", repositoryRoot, "The repository root: the plan's scene paths are relative to it")
-        ->capture_default_str();
-    job->add_option("--threads", jobThreads, "Worker threads (0: all)")->check(tools::threadCount());
-    refray::tools::DiscriminateCommandOptions discriminateOptions;
-    CLI::App* discriminate = refray::tools::addDiscriminateCommand(*golden, discriminateOptions);
-    const auto printRender = [](const std::string& what, double seconds) {
-        std::printf("    %-28s %7.2f s\n", what.c_str(), seconds);
-        std::fflush(stdout);
-    };
+    refray::tools::GoldenCommandOptions goldenOptions;
+    CLI::App* golden = refray::tools::addGoldenCommand(app, goldenOptions);
 
     try {
         app.parse(argc, argv);
-        const auto emitJobs = [&](const std::string& file, const std::string& dir, const char* collect) {
-            const std::vector<std::string> lines =
-                scenes::goldenJobCommands(dir, repositoryRoot, std::filesystem::read_symlink("/proc/self/exe").string());
-            std::string text;
-            for (const std::string& line : lines) text += line + "\n";
-            std::ofstream out(file);
-            REFRAY_CHECK(out << text, "cannot write '" << file << "'");
-            std::printf("wrote %zu job lines to %s (plan: %s/jobs/plan.json); run them (e.g. 'parallel < %s', or a "
-                        "Slurm array: README), then: %s\n",
-                        lines.size(), file.c_str(), dir.c_str(), file.c_str(), collect);
-            return 0;
-        };
-        const auto printCollected = [](const scenes::GoldenEntry& e) {
-            std::printf("%-48s %ux%u  %llu sensitive, %llu order-dependent pixels\n", e.name.c_str(), e.width, e.height,
-                        (unsigned long long)e.sensitivePixels, (unsigned long long)e.orderDependentPixels);
-        };
-        if (*job) {
-            scenes::runGoldenJob(jobDir, repositoryRoot, jobName, jobPart, jobThreads);
-            return 0;
-        }
-        if (*make && makeCollect) {
-            REFRAY_CHECK(makeScene.empty() && makeEmitJobs.empty(),
-                         "--collect reads the plan in " << makeDir << "/jobs; give no scene and no --emit-jobs");
-            const scenes::GoldenSet set = scenes::collectGoldens(makeDir, printCollected);
-            std::printf("collected %s/goldens.json (%zu goldens)\n", makeDir.c_str(), set.entries.size());
-            return 0;
-        }
-        if (*update && updateCollect) {
-            REFRAY_CHECK(updateEmitJobs.empty(), "--collect and --emit-jobs are separate steps; give one of them");
-            const scenes::GoldenSet set = scenes::collectGoldens(goldenDir, printCollected);
-            std::printf("collected %zu goldens into %s/goldens.json\n", set.entries.size(), goldenDir.c_str());
-            return 0;
-        }
-        if (*make) {
-            REFRAY_CHECK(!makeScene.empty(), "refray golden make needs a scene file (or --collect)");
-            const Size size = parseSize(makeSize);
-            scenes::GoldenMakeOptions options;
-            options.sceneFile = makeScene;
-            options.repositoryRoot = repositoryRoot;
-            options.goldenDirectory = makeDir;
-            options.camera = makeCamera;
-            options.time = makeTime;
-            options.width = size.width;
-            options.height = size.height;
-            options.orders = makeOrders;
-            options.perturbedRenders = makePerturbed;
-            options.refrayCommit = refray::tools::kCommit;
-            options.render.threads = makeThreads;
-            options.render.onRender = printRender;
-            if (!makeEmitJobs.empty()) {
-                scenes::writeGoldenPlan(makeDir, {scenes::planMake(options)}, false);
-                return emitJobs(makeEmitJobs, makeDir, ("refray golden make --collect -o " + makeDir).c_str());
-            }
-            const scenes::GoldenEntry e = scenes::makeGolden(options);
-            std::printf("wrote %s/%s (%llu sensitive, %llu order-dependent pixels) and %s/goldens.json\n",
-                        makeDir.c_str(), e.envelope.c_str(), (unsigned long long)e.sensitivePixels,
-                        (unsigned long long)e.orderDependentPixels, makeDir.c_str());
-            return 0;
-        }
-        if (*discriminate) return refray::tools::runDiscriminate(discriminateOptions);
+        if (*golden) return refray::tools::runGolden(goldenOptions);
         if (*render) return runRender(ro);
         if (*compare) return refray::tools::runCompare(compareOptions);
         if (*table) return refray::tools::runTable(tableOptions);
         if (*explain) return refray::tools::runExplain(explainOptions);
         if (*sweep) return refray::tools::runSweep(sweepOptions);
-        if (*update) {
-            const Size size = parseSize(goldenSize);
-            scenes::GoldenUpdateOptions options;
-            options.repositoryRoot = repositoryRoot;
-            options.goldenDirectory = goldenDir;
-            options.width = size.width;
-            options.height = size.height;
-            options.orders = goldenOrders;
-            options.threads = goldenThreads;
-            options.perturbedRenders = goldenPerturbed;
-            options.refrayCommit = refray::tools::kCommit;
-            options.onRender = printRender;
-            options.onEntry = [](const scenes::GoldenEntry& e, double seconds) {
-                std::printf("%-48s %ux%u  %6.2f s  %llu sensitive, %llu order-dependent pixels\n", e.name.c_str(),
-                            e.width, e.height, seconds, (unsigned long long)e.sensitivePixels,
-                            (unsigned long long)e.orderDependentPixels);
-                std::fflush(stdout);
-            };
-            if (!updateEmitJobs.empty()) {
-                scenes::writeGoldenPlan(goldenDir, scenes::planUpdate(options), true);
-                return emitJobs(updateEmitJobs, goldenDir, ("refray golden update --collect --dir " + goldenDir).c_str());
-            }
-            const scenes::GoldenSet set = scenes::updateGoldens(options);
-            std::printf("wrote %zu goldens and %s/goldens.json\n", set.entries.size(), goldenDir.c_str());
-            return 0;
-        }
     } catch (const CLI::ParseError& e) {
         return refray::tools::parseErrorStatus(app, e);
     } catch (const refray::dxr::DxrError& e) {

@@ -14,6 +14,7 @@ packages=(
   fonts-dejavu-core  # legends of index maps (refray render --aov) are drawn with DejaVu Sans
   clang libclang-rt-14-dev  # libFuzzer programs (tools/fuzz.sh)
   parallel  # the README's example of running 'refray sweep --emit-jobs' lines (a test runs it)
+  python3  # tools/make_discrimination_report.sh and the GPU round's scripts write their tables with it
   slurm-wlm munge  # a single-node Slurm cluster runs the lines of 'refray golden update --emit-jobs' (a test starts it)
   libvulkan-dev glslang-tools spirv-tools  # the Vulkan back end (gpu/): headers, loader, GLSL -> SPIR-V, spirv-val
 )

@@ -139,6 +139,15 @@ TEST(RefrayCliParseErrors, GoldenUpdateNamesTheOptionAndWhatItAccepts) {
                    "refray golden update: --threads: expects a number of worker threads (0: all), got 'many'");
 }
 
+TEST(RefrayCliParseErrors, GoldenMakeJobAndDiscriminateNameTheOptionAndWhatItAccepts) {
+    expectBadInput("golden make scene.json -o dir --perturbed -2",
+                   "refray golden make: --perturbed: expects a number of perturbed renders, got '-2'");
+    expectBadInput("golden job dir name nominal --threads x",
+                   "refray golden job: --threads: expects a number of worker threads (0: all), got 'x'");
+    expectBadInput("golden discriminate --threads x",
+                   "refray golden discriminate: --threads: expects a number of worker threads (0: all), got 'x'");
+}
+
 TEST(RefrayCliParseErrors, TableNamesTheOptionAndWhatItAccepts) {
     expectBadInput("table scene.json --precision doubel",
                    "refray table: --precision: expects float or double, got 'doubel' (did you mean 'double'?)");
@@ -165,11 +174,13 @@ TEST(RefrayCliParseErrors, MissingAndExtraArgumentsAndSubcommands) {
     expectBadInput("render builtin --spp", "refray render: --spp");
     expectBadInput("rendr builtin", "refray: expects a subcommand (");
     expectBadInput("rendr builtin", "got 'rendr' (did you mean 'render'?)");
-    expectBadInput("golden", "refray golden: expects a subcommand (update)");
+    expectBadInput("golden", "refray golden: expects a subcommand (update, make, job or discriminate)");
+    expectBadInput("golden job", "refray golden job: dir is required");
 }
 
 TEST(RefrayCliParseErrors, HelpAndVersionStillExitZero) {
-    for (const char* command : {"--help", "render --help", "compare --help", "golden update --help", "table --help",
+    for (const char* command : {"--help", "render --help", "compare --help", "golden update --help", "golden make --help",
+                                "golden job --help", "golden discriminate --help", "table --help",
                                 "explain --help", "sweep --help"}) {
         const CliRun r = run(command);
         EXPECT_EQ(r.status, 0) << command << "\n" << r.output;
