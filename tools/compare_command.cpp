@@ -325,10 +325,20 @@ GoldenFile resolveGolden(const std::string& golden, const std::string& candidate
     for (const scenes::GoldenEntry& e : set.entries)
         if (e.name == stem || set.entries.size() == 1) g.entry = e;
     if (!g.entry) {
+        // No golden of that name: the one golden whose camera the candidate is named after ("julia.png"), if only one.
+        std::vector<const scenes::GoldenEntry*> byCamera;
+        for (const scenes::GoldenEntry& e : set.entries)
+            if (e.camera == stem) byCamera.push_back(&e);
+        if (byCamera.size() == 1) g.entry = *byCamera.front();
+    }
+    if (!g.entry) {
         std::string names;
         for (const scenes::GoldenEntry& e : set.entries) names += (names.empty() ? "" : ", ") + e.name;
         REFRAY_CHECK(false, "no golden in " << manifest.string() << " is named '" << stem << "' (from the candidate "
-                                            << candidate << "); it holds: " << names);
+                                            << candidate << "), nor is one alone made with a camera of that name; it "
+                                                            "holds: "
+                                            << names << " (name the candidate <golden name>.png or .exr, or pass the "
+                                                        "golden's .envelope.exr)");
     }
     checkSceneUnchanged(*g.entry, golden);
     g.name = g.entry->name;

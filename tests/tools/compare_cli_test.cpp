@@ -387,3 +387,20 @@ TEST(CompareCliEnvelope, GoldenSetReportsAMissingCandidateAsAFailureWithJUnit) {
     r = compare("--golden-set " + dir + " " + candidates + " --junit " + candidates + "/results.xml");
     EXPECT_EQ(r.status, 0) << r.output;
 }
+
+// In a directory of several goldens the candidate is found by the golden's name, or by its camera where one golden
+// alone has it ("julia.png" for "proceduray-mandel-julia-pac.julia"); anything else names what the directory holds.
+TEST(CompareCliEnvelope, ACandidateIsFoundByTheGoldensNameOrItsCamera) {
+    const std::string golden = std::string(REFRAY_SOURCE_DIR) + "/tests/golden";
+    const std::string dir = directory("envelope-by-camera");
+    const std::string gpu = std::string(REFRAY_SOURCE_DIR) + "/tests/gpu-renders/images/proceduray-mandel-julia-pac.julia.exr";
+    std::filesystem::copy_file(gpu, dir + "/julia.exr");
+    CliRun r = compare("--golden " + golden + " " + dir + "/julia.exr");
+    EXPECT_NE(r.status, 4) << r.output;
+    EXPECT_TRUE(contains(r.output, "proceduray-mandel-julia-pac.julia.envelope.exr")) << r.output;
+    std::filesystem::copy_file(gpu, dir + "/close-up.exr");
+    r = compare("--golden " + golden + " " + dir + "/close-up.exr");
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(contains(r.output, "is named 'close-up'")) << r.output;
+    EXPECT_TRUE(contains(r.output, "proceduray-mandel-julia-pac.mandelbulb")) << r.output;
+}
