@@ -511,6 +511,8 @@ GoldenSet collectGoldens(const fs::path& goldenDirectory, const std::function<vo
         if (onEntry) onEntry(e);
     }
     writeGoldenManifest(manifest, set);
+    // The plan and the renders were only the way here: a golden directory holds goldens (tests/golden stays clean).
+    fs::remove_all(jobs);
     return set;
 }
 

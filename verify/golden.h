@@ -168,7 +168,8 @@ std::vector<std::string> goldenJobCommands(const std::filesystem::path& goldenDi
                                            const std::filesystem::path& repositoryRoot, const std::string& refray);
 void runGoldenJob(const std::filesystem::path& goldenDirectory, const std::filesystem::path& repositoryRoot,
                   const std::string& name, const std::string& part, uint32_t threads);
-// Throws refray::Error listing the missing renders (and the lines that make them) before writing anything.
+// Throws refray::Error listing the missing renders (and the lines that make them) before writing anything; on success
+// removes <dir>/jobs.
 GoldenSet collectGoldens(const std::filesystem::path& goldenDirectory,
                          const std::function<void(const GoldenEntry&)>& onEntry);
 

@@ -46,6 +46,7 @@ TEST(GoldenJobsCli, ParallelLinesCollectToTheInProcessGolden) {
     ASSERT_EQ(r.status, 0) << r.output;
     r = runRefray("golden make --collect -o " + (dir / "distributed").string());
     ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "distributed/jobs")) << "the collect leaves its plan and renders behind";
     r = runRefray(kMake + " -o " + (dir / "local").string());
     ASSERT_EQ(r.status, 0) << r.output;
 
