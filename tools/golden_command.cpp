@@ -2,7 +2,6 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 
 #include "core/error.h"
 #include "tools/cli_common.h"
@@ -36,8 +35,7 @@ int emitJobs(const GoldenCommandOptions& o, const std::string& file, const std::
         scenes::goldenJobCommands(dir, o.repositoryRoot, fs::read_symlink("/proc/self/exe").string());
     std::string text;
     for (const std::string& line : lines) text += line + "\n";
-    std::ofstream out(file);
-    REFRAY_CHECK(out << text, "cannot write '" << file << "'");
+    writeTextFile(file, text);
     std::printf("wrote %zu job lines to %s (plan: %s/jobs/plan.json); run them (e.g. 'parallel < %s', or a Slurm "
                 "array: README), then: %s\n",
                 lines.size(), file.c_str(), dir.c_str(), file.c_str(), collect.c_str());
@@ -149,10 +147,7 @@ int runDiscriminate(const GoldenCommandOptions& o) {
     };
     const std::vector<scenes::DiscriminationRow> rows = scenes::runDiscrimination(options);
     const std::string markdown = scenes::discriminationMarkdown(rows);
-    if (!d.markdown.empty()) {
-        std::ofstream out(d.markdown);
-        REFRAY_CHECK(out << markdown, "cannot write '" << d.markdown << "'");
-    }
+    if (!d.markdown.empty()) writeTextFile(d.markdown, markdown);
     bool falseAlarm = false, missed = false;
     for (const scenes::DiscriminationRow& r : rows) {
         if (scenes::outcomeAsExpected(r)) continue;

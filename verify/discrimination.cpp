@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <map>
 #include <sstream>
 
@@ -14,6 +13,7 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "core/json.h"
+#include "core/strings.h"
 #include "scenes/knobs.h"
 #include "scenes/scene.h"
 #include "scenes/scene_loader.h"
@@ -216,12 +216,6 @@ Image mutateImage(const Image& in, const std::string& name) {
 
 bool startsWith(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
 
-std::string shellQuote(const std::string& s) {
-    std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
 // refray-fma renders the golden's settings into a temporary EXR.
 Image renderFused(const DiscriminationOptions& o, const GoldenEntry& e, std::string& error) {
     if (o.fusedRefray.empty()) {
@@ -229,12 +223,12 @@ Image renderFused(const DiscriminationOptions& o, const GoldenEntry& e, std::str
         return {};
     }
     const fs::path out = fs::temp_directory_path() / ("refray-fma-" + std::to_string(::getpid()) + "-" + e.name + ".exr");
-    const std::string command = shellQuote(o.fusedRefray.string()) + " render " +
-                                shellQuote((o.repositoryRoot / e.scene).string()) + " --camera " +
-                                shellQuote(e.camera) + " --time " + shellQuote(e.time) + " --size " +
+    const std::string command = shellQuoted(o.fusedRefray.string()) + " render " +
+                                shellQuoted((o.repositoryRoot / e.scene).string()) + " --camera " +
+                                shellQuoted(e.camera) + " --time " + shellQuoted(e.time) + " --size " +
                                 std::to_string(e.width) + "x" + std::to_string(e.height) + " --precision " +
                                 e.precision + " --threads " + std::to_string(o.threads) + " -o " +
-                                shellQuote(out.string()) + " > /dev/null";
+                                shellQuoted(out.string()) + " > /dev/null";
     const int status = std::system(command.c_str());
     if (status != 0) {
         error = "refray-fma exited with status " + std::to_string(status) + ": " + command;

@@ -9,6 +9,8 @@
 #include "core/error.h"
 #include "core/hash.h"
 #include "core/json.h"
+#include "core/strings.h"
+#include "core/text_file.h"
 #include "emulator/validation.h"
 #include "scenes/scene_loader.h"
 
@@ -416,24 +418,18 @@ void writeGoldenPlan(const fs::path& goldenDirectory, const std::vector<GoldenEn
     GoldenSet plan;
     plan.entries = entries;
     writeGoldenManifest(jobs / "plan.json", plan);
-    std::ofstream mode(jobs / "mode");
-    REFRAY_CHECK(mode << kPlanMode[update] << "\n", "cannot write " << (jobs / "mode").string());
+    writeTextFile((jobs / "mode").string(), std::string(kPlanMode[update]) + "\n");
 }
 
 std::vector<std::string> goldenJobCommands(const fs::path& goldenDirectory, const fs::path& repositoryRoot,
                                            const std::string& refray) {
     const GoldenSet plan = readGoldenManifest(goldenDirectory / "jobs" / "plan.json");
-    const auto quote = [](const std::string& text) {
-        std::string q = "'";
-        for (char c : text) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-        return q + "'";
-    };
     std::vector<std::string> lines;
     for (const GoldenEntry& e : plan.entries)
         for (const EnvelopePart& part : envelopeParts(e, 0))
-            lines.push_back(quote(refray) + " golden job " + quote(fs::absolute(goldenDirectory).string()) + " " +
-                            quote(e.name) + " " + part.name + " --root " + quote(fs::absolute(repositoryRoot).string()) +
-                            " --threads 1");
+            lines.push_back(shellQuoted(refray) + " golden job " + shellQuoted(fs::absolute(goldenDirectory).string()) +
+                            " " + shellQuoted(e.name) + " " + part.name + " --root " +
+                            shellQuoted(fs::absolute(repositoryRoot).string()) + " --threads 1");
     return lines;
 }
 
@@ -551,11 +547,13 @@ GoldenSet updateGoldens(const GoldenUpdateOptions& options) {
     GoldenSet set;
     set.statistical = existingSet(manifest).statistical;
     std::unique_ptr<Scene> scene;
+    std::string sceneFile;  // the planned entries come file by file: each file is built once
     for (GoldenEntry e : planned) {
         const auto start = std::chrono::steady_clock::now();
-        if (!scene || scene->desc().fileHash != e.sceneSha256 ||
-            fs::path(scene->desc().file).filename() != fs::path(e.scene).filename())
+        if (!scene || sceneFile != e.scene) {
             scene = std::make_unique<Scene>(loadSceneFile(options.repositoryRoot / e.scene));
+            sceneFile = e.scene;
+        }
         EnvelopeRenderOptions render;
         render.threads = options.threads;
         render.onRender = options.onRender;
