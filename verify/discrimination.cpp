@@ -217,8 +217,10 @@ Image mutateImage(const Image& in, const std::string& name) {
 bool startsWith(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
 
 // refray-fma renders the golden's settings into a temporary EXR.
-Image renderFused(const DiscriminationOptions& o, const GoldenEntry& e, std::string& error) {
+Image renderFused(const DiscriminationOptions& o, const GoldenEntry& e, DiscriminationRow& row) {
+    std::string& error = row.error;
     if (o.fusedRefray.empty()) {
+        row.unavailable = true;
         error = "no refray-fma binary given (--fma-refray, or build the refray-fma target)";
         return {};
     }
@@ -286,7 +288,7 @@ std::vector<DiscriminationRow> runDiscrimination(const DiscriminationOptions& o)
                     s.adversarialSeed = std::stoul(n.substr(11));
                     image = scene->render(s).image;
                 } else if (n == "fma-contraction") {
-                    image = renderFused(o, entry, row.error);
+                    image = renderFused(o, entry, row);
                 } else if (startsWith(c.how, "--knob ")) {
                     applyKnobAssignment(s, c.how.substr(7));
                     image = scene->render(s).image;
@@ -331,9 +333,7 @@ std::vector<DiscriminationRow> runDiscrimination(const DiscriminationOptions& o)
 }
 
 std::string outcomeName(const DiscriminationRow& row) {
-    if (!row.ran) return row.candidate.name == "fma-contraction" && startsWith(row.error, "no refray-fma")
-                             ? "not run"
-                             : "render error";
+    if (!row.ran) return row.unavailable ? "not run" : "render error";
     switch (row.judgement.verdict) {
         case CompareVerdict::Pass: return "pass";
         case CompareVerdict::Warn: return "WARNING";

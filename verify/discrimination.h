@@ -47,6 +47,7 @@ struct DiscriminationRow {
     std::string golden;  // the golden's name
     DiscriminationCandidate candidate;
     bool ran = false;
+    bool unavailable = false;  // not run: the tool the candidate needs is missing (`error` says which)
     std::string error;   // why it did not run, or the render's error (a mutant that cannot render at all)
     std::string note;    // how it ran where that differs from the candidate's recipe
     EnvelopeJudgement judgement;  // heat map and pixel list dropped
