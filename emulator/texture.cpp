@@ -373,4 +373,16 @@ vec4 Texture2D::Load(ivec2 texel, int mipLevel) const {
     return impl_->texel(mipLevel, texel.x, texel.y);
 }
 
+std::vector<vec4> Texture2D::readLevel(uint32_t mipLevel) const {
+    REFRAY_CHECK(mipLevel < impl_->levels.size(), "texture '" << impl_->path << "' has " << impl_->levels.size()
+                                                              << " MIP levels; level " << mipLevel << " was asked for");
+    const ivec2 size = impl_->levels[mipLevel];
+    const int channels = impl_->readChannels;
+    std::vector<float> file(size_t(size.x) * size_t(size.y) * size_t(channels));
+    impl_->read(int(mipLevel), 0, size.x, 0, size.y, file.data());
+    std::vector<vec4> texels(size_t(size.x) * size_t(size.y));
+    for (size_t i = 0; i < texels.size(); ++i) texels[i] = impl_->expand(file.data() + i * size_t(channels));
+    return texels;
+}
+
 }  // namespace refray::dxr

@@ -13,6 +13,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "core/math.h"
 
@@ -132,6 +133,10 @@ public:
     // HLSL Texture2D.Load(int3(texel, mipLevel)): one texel, no filtering or addressing. A texel or level out of
     // range reads (0, 0, 0, 0), as D3D defines.
     vec4 Load(ivec2 texel, int mipLevel = 0) const;
+    // Every texel of MIP level `mipLevel` as Load returns it (RGBA, sRGB decoded where the texture says so), row by
+    // row from the top: what a back end uploads so that its sampler filters the same texels. Throws refray::Error
+    // for a level past the last or a file that cannot be read any more.
+    std::vector<vec4> readLevel(uint32_t mipLevel) const;
 
 private:
     struct Impl;

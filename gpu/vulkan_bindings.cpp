@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "emulator/limits.h"
+#include "gpu/vulkan_sampler.h"
 
 namespace refray::gpu {
 
@@ -46,13 +47,23 @@ std::vector<DescriptorBinding> translateGlobalBindings(const dxr::RootArguments&
         REFRAY_CHECK(b.source != RegisterBinding::Source::RootConstants,
                      "global root signature '" << signature.name() << "': " << described
                                                << " are global root constants, which the Vulkan back end does not "
-                                                  "map (gpu/shaders/CONTRACT.md binds buffers, images and the TLAS)");
-        REFRAY_CHECK(b.source != RegisterBinding::Source::StaticSampler && b.type != DescriptorRangeType::Sampler,
-                     "global root signature '" << signature.name() << "': " << described
-                                               << " is a sampler; the Vulkan back end has no samplers or textures yet");
-        REFRAY_CHECK(!b.unbounded(), "global root signature '" << signature.name() << "': " << described
-                                                               << " is unbounded; the Vulkan back end binds "
-                                                                  "bounded ranges only");
+                                                  "map (gpu/shaders/CONTRACT.md binds buffers, images, textures, "
+                                                  "samplers and the TLAS)");
+
+        if (b.source == RegisterBinding::Source::StaticSampler) {
+            // An immutable sampler: baked into the set layout, as a static sampler is into the root signature.
+            DescriptorBinding d;
+            d.set = b.space;
+            d.binding = kBindingShiftSampler + b.firstRegister;
+            d.type = VK_DESCRIPTOR_TYPE_SAMPLER;
+            d.resource = DescriptorBinding::Resource::Sampler;
+            d.sampler = signature.staticSampler(b.index);
+            d.staticSampler = true;
+            d.what = "global root signature '" + signature.name() + "': " + described;
+            samplerCreateInfo(d.sampler, d.what);  // refuses here, before any device work
+            out.push_back(d);
+            continue;
+        }
 
         if (b.source == RegisterBinding::Source::RootDescriptor) {
             DescriptorBinding d;
@@ -74,19 +85,47 @@ std::vector<DescriptorBinding> translateGlobalBindings(const dxr::RootArguments&
             continue;
         }
 
-        // A descriptor table range: one binding per descriptor.
+        // A descriptor table range.
         const dxr::GpuDescriptorHandle table = argument(b.index);
         const dxr::DescriptorHeap* heap = device.findDescriptorHeap(table);
         REFRAY_CHECK(heap, "global root signature '" << signature.name() << "': the table for " << described
                                                      << " points at no descriptor heap of this device");
+        const uint32_t first = heap->indexOf(table) + b.offsetInTable;  // the range's first descriptor in the heap
+        const std::string heapName = "heap '" + heap->name() + "'";
+
+        if (b.unbounded()) {
+            // One arrayed binding over the run of Texture2D descriptors from the range's start (vulkan_bindings.h).
+            DescriptorBinding d;
+            d.set = b.space;
+            d.binding = bindingShift(b.type) + b.firstRegister;
+            d.type = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
+            d.resource = DescriptorBinding::Resource::SampledImages;
+            d.runtimeArray = true;
+            d.what = std::string(1, dxr::registerLetter(b.type)) + std::to_string(b.firstRegister) + ".., space" +
+                     std::to_string(b.space) + " (unbounded, descriptors " + std::to_string(first) + ".. of " +
+                     heapName + ")";
+            REFRAY_CHECK(b.type == DescriptorRangeType::SRV,
+                         "global root signature '" << signature.name() << "': " << described << " is an unbounded "
+                                                   << dxr::toString(b.type) << " range; the Vulkan back end binds "
+                                                                                "unbounded ranges of Texture2D SRVs only");
+            for (uint32_t i = first; i < heap->size() && heap->descriptor(i).kind == dxr::Descriptor::Kind::Texture2D; ++i)
+                d.textures.push_back(heap->descriptor(i).texture.get());
+            REFRAY_CHECK(!d.textures.empty(),
+                         d.what << " starts at a " << (first < heap->size() ? dxr::toString(heap->descriptor(first).kind)
+                                                                            : std::string_view("point past the heap"))
+                                << " descriptor; the Vulkan back end binds unbounded ranges of Texture2D SRVs only");
+            out.push_back(d);
+            continue;
+        }
+
         for (uint32_t r = 0; r < b.count; ++r) {
             const uint32_t reg = b.firstRegister + r;
             const dxr::Descriptor& descriptor = heap->at(table, b.offsetInTable + r);
             DescriptorBinding d;
             d.set = b.space;
             d.binding = bindingShift(b.type) + reg;
-            d.what = registerName(b.type, reg, b.space) + " (descriptor " +
-                     std::to_string(heap->indexOf(table) + b.offsetInTable + r) + " of heap '" + heap->name() + "')";
+            d.what = registerName(b.type, reg, b.space) + " (descriptor " + std::to_string(first + r) + " of " +
+                     heapName + ")";
             switch (descriptor.kind) {
                 case dxr::Descriptor::Kind::Null:
                     throw Error(d.what + " was never written (BIND-4)");
@@ -105,9 +144,16 @@ std::vector<DescriptorBinding> translateGlobalBindings(const dxr::RootArguments&
                     d.image = descriptor.image;
                     break;
                 case dxr::Descriptor::Kind::Texture2D:
+                    d.type = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
+                    d.resource = DescriptorBinding::Resource::SampledImages;
+                    d.textures = {descriptor.texture.get()};
+                    break;
                 case dxr::Descriptor::Kind::Sampler:
-                    throw Error(d.what + " is a " + std::string(dxr::toString(descriptor.kind)) +
-                                "; the Vulkan back end has no textures or samplers yet");
+                    d.type = VK_DESCRIPTOR_TYPE_SAMPLER;
+                    d.resource = DescriptorBinding::Resource::Sampler;
+                    d.sampler = descriptor.sampler;
+                    samplerCreateInfo(d.sampler, d.what);
+                    break;
             }
             out.push_back(d);
         }

@@ -1,6 +1,7 @@
 #include "gpu/vulkan_context.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <cstring>
 #include <sstream>
@@ -19,6 +20,25 @@ std::string driverVersionText(uint32_t vendorID, uint32_t v) {
     if (vendorID == 0x10DE)
         return std::to_string(v >> 22) + "." + std::to_string((v >> 14) & 0xFF) + "." + std::to_string((v >> 6) & 0xFF);
     return versionText(v);
+}
+
+std::string deviceTypeName(VkPhysicalDeviceType type) {
+    switch (type) {
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual GPU";
+        case VK_PHYSICAL_DEVICE_TYPE_CPU: return "CPU";
+        default: return "other";
+    }
+}
+
+// "25.0.7" from Mesa's driverInfo ("Mesa 25.0.7-2~bpo12+1 (LLVM 15.0.6)"); empty for other drivers.
+std::string mesaVersionOf(const std::string& driverInfo) {
+    const size_t at = driverInfo.find("Mesa ");
+    if (at == std::string::npos) return "";
+    size_t end = at + 5;
+    while (end < driverInfo.size() && (std::isdigit((unsigned char)driverInfo[end]) || driverInfo[end] == '.')) ++end;
+    return driverInfo.substr(at + 5, end - at - 5);
 }
 
 // The features refray's shaders and host need, chained for vkGetPhysicalDeviceFeatures2 and vkCreateDevice.
@@ -122,6 +142,10 @@ VulkanContext::VulkanContext(const VulkanContextOptions& options) : options_(opt
     createDevice();
 }
 
+VulkanContext::VulkanContext(InstanceOnly) { createInstance(); }
+
+std::vector<PhysicalDeviceSummary> listVulkanDevices() { return VulkanContext(VulkanContext::InstanceOnly{}).summaries(); }
+
 VulkanContext::~VulkanContext() {
     const VulkanFunctions& f = vk();
     if (device_) {
@@ -174,6 +198,35 @@ void VulkanContext::createInstance() {
     loader_.loadInstance(instance_);
 }
 
+std::vector<PhysicalDeviceSummary> VulkanContext::summaries() const {
+    const VulkanFunctions& f = vk();
+    uint32_t count = 0;
+    REFRAY_VK(f.vkEnumeratePhysicalDevices(instance_, &count, nullptr));
+    std::vector<VkPhysicalDevice> devices(count);
+    REFRAY_VK(f.vkEnumeratePhysicalDevices(instance_, &count, devices.data()));
+    std::vector<PhysicalDeviceSummary> out;
+    for (uint32_t i = 0; i < count; ++i) {
+        auto driver = vkStruct<VkPhysicalDeviceDriverProperties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES);
+        auto properties = vkStruct<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &driver);
+        f.vkGetPhysicalDeviceProperties(devices[i], &properties.properties);
+        if (properties.properties.apiVersion >= VK_API_VERSION_1_2) f.vkGetPhysicalDeviceProperties2(devices[i], &properties);
+        const VkPhysicalDeviceProperties& p = properties.properties;
+        PhysicalDeviceSummary d;
+        d.index = i;
+        d.name = p.deviceName;
+        d.type = deviceTypeName(p.deviceType);
+        d.cpu = p.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+        d.driverName = driver.driverName;
+        d.driverInfo = driver.driverInfo[0] ? std::string(driver.driverInfo) : driverVersionText(p.vendorID, p.driverVersion);
+        d.apiVersion = versionText(p.apiVersion);
+        d.missing = missingRequirements(f, devices[i], true);
+        d.rayTracing = d.missing.empty();
+        d.rayQuery = hasExtension(deviceExtensions(f, devices[i]), VK_KHR_RAY_QUERY_EXTENSION_NAME);
+        out.push_back(std::move(d));
+    }
+    return out;
+}
+
 void VulkanContext::chooseDevice() {
     const VulkanFunctions& f = vk();
     uint32_t count = 0;
@@ -181,34 +234,81 @@ void VulkanContext::chooseDevice() {
     REFRAY_CHECK(count > 0, "no Vulkan physical device: the loader " << loader_.libraryName()
                                                                      << " and a driver are present, but the driver "
                                                                         "reports no device (is the GPU visible to this "
-                                                                        "process? nvidia-smi)");
+                                                                        "process? nvidia-smi; for a CPU driver: bash "
+                                                                        "tools/setup.sh installs Mesa's lavapipe)");
     std::vector<VkPhysicalDevice> devices(count);
     REFRAY_VK(f.vkEnumeratePhysicalDevices(instance_, &count, devices.data()));
 
-    std::ostringstream report;
-    int best = -1;
-    bool bestIsDiscrete = false;
-    for (uint32_t i = 0; i < count; ++i) {
-        VkPhysicalDeviceProperties properties;
-        f.vkGetPhysicalDeviceProperties(devices[i], &properties);
-        const std::vector<std::string> missing = missingRequirements(f, devices[i], options_.rayTracing);
-        if (!missing.empty()) {
-            report << "\n  device " << i << " '" << properties.deviceName << "' lacks " << joinedList(missing);
-            continue;
+    uint32_t chosen = 0;
+    if (options_.rayTracing) {
+        chosen = chooseRayTracingDevice(summaries(), options_.device);
+    } else {
+        // Buffers and images only (tests): the first device with Vulkan 1.2 and buffer device addresses.
+        std::ostringstream report;
+        int best = -1;
+        for (uint32_t i = 0; i < count && best < 0; ++i) {
+            VkPhysicalDeviceProperties properties;
+            f.vkGetPhysicalDeviceProperties(devices[i], &properties);
+            const std::vector<std::string> missing = missingRequirements(f, devices[i], false);
+            if (missing.empty()) best = int(i);
+            else report << "\n  device " << i << " '" << properties.deviceName << "' lacks " << joinedList(missing);
         }
-        // The first discrete GPU that qualifies, else the first device that does.
-        const bool discrete = properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU;
-        if (best < 0 || (discrete && !bestIsDiscrete)) {
-            best = int(i);
-            bestIsDiscrete = discrete;
-        }
+        REFRAY_CHECK(best >= 0, "no Vulkan 1.2 device with buffer device addresses:" << report.str());
+        chosen = uint32_t(best);
     }
-    if (best < 0)
-        throw Error("no Vulkan device with ray tracing: refray needs " + joinedList(requiredDeviceExtensions()) +
-                    " with the bufferDeviceAddress, scalarBlockLayout, shaderInt64, accelerationStructure and "
-                    "rayTracingPipeline features (Vulkan 1.2)." + report.str());
-    physicalDevice_ = devices[size_t(best)];
+    physicalDevice_ = devices[chosen];
+    info_.index = chosen;
     queueFamily_ = uint32_t(computeQueueFamily(f, physicalDevice_));
+}
+
+uint32_t chooseRayTracingDevice(const std::vector<PhysicalDeviceSummary>& devices, const std::string& selector) {
+    const auto listing = [&] {
+        std::ostringstream report;
+        for (const PhysicalDeviceSummary& d : devices) {
+            report << "\n  device " << d.index << " '" << d.name << "' (" << d.type << ", " << d.driverName << ")";
+            if (d.rayTracing) report << ": ray tracing";
+            else report << " lacks " << joinedList(d.missing);
+        }
+        return report.str();
+    };
+    const std::string requirement = "refray needs " + joinedList(requiredDeviceExtensions()) +
+                                    " with the bufferDeviceAddress, scalarBlockLayout, shaderInt64, "
+                                    "accelerationStructure and rayTracingPipeline features (Vulkan 1.2)";
+    if (!selector.empty()) {
+        const bool isIndex = std::all_of(selector.begin(), selector.end(), [](unsigned char c) { return std::isdigit(c); });
+        const auto lower = [](std::string t) {
+            std::transform(t.begin(), t.end(), t.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+            return t;
+        };
+        for (const PhysicalDeviceSummary& d : devices) {
+            const bool match = isIndex ? std::to_string(d.index) == selector
+                                       : lower(d.name).find(lower(selector)) != std::string::npos ||
+                                             lower(d.driverName).find(lower(selector)) != std::string::npos;
+            if (!match) continue;
+            if (!d.rayTracing)
+                throw Error("the Vulkan device '" + selector + "' selects device " + std::to_string(d.index) + " '" +
+                            d.name + "', which cannot ray trace: it lacks " + joinedList(d.missing) + "; " +
+                            requirement + "." + listing());
+            return d.index;
+        }
+        throw Error("no Vulkan device matches '" + selector + "' (an index, or part of a device or driver name; "
+                    "'refray devices' lists them):" + listing());
+    }
+    // A hardware device first (discrete, then integrated, then virtual or other), a CPU driver (lavapipe) last.
+    const auto rank = [](const PhysicalDeviceSummary& d) {
+        if (d.cpu) return 4;
+        if (d.type == "discrete GPU") return 0;
+        if (d.type == "integrated GPU") return 1;
+        if (d.type == "virtual GPU") return 2;
+        return 3;
+    };
+    int best = -1;
+    for (const PhysicalDeviceSummary& d : devices)
+        if (d.rayTracing && (best < 0 || rank(d) < rank(devices[size_t(best)]))) best = int(&d - devices.data());
+    if (best < 0)
+        throw Error("no Vulkan device with ray tracing: " + requirement + "." + listing() +
+                    "\n  (bash tools/setup.sh, as root, installs Mesa's lavapipe, a CPU driver that ray traces)");
+    return devices[size_t(best)].index;
 }
 
 void VulkanContext::createDevice() {
@@ -229,6 +329,8 @@ void VulkanContext::createDevice() {
     info_.driverVersion = driver.driverInfo[0] ? std::string(driver.driverInfo) : driverVersionText(p.vendorID, p.driverVersion);
     info_.apiVersion = versionText(p.apiVersion);
     info_.loader = loader_.libraryName();
+    info_.type = deviceTypeName(p.deviceType);
+    info_.mesaVersion = mesaVersionOf(info_.driverVersion);
     limits_.shaderGroupHandleSize = rayTracing.shaderGroupHandleSize;
     limits_.shaderGroupHandleAlignment = rayTracing.shaderGroupHandleAlignment;
     limits_.shaderGroupBaseAlignment = rayTracing.shaderGroupBaseAlignment;
@@ -237,6 +339,7 @@ void VulkanContext::createDevice() {
     limits_.minAccelerationStructureScratchOffsetAlignment =
         accelerationStructure.minAccelerationStructureScratchOffsetAlignment;
     limits_.maxUniformBufferRange = p.limits.maxUniformBufferRange;
+    limits_.maxBoundDescriptorSets = p.limits.maxBoundDescriptorSets;
     f.vkGetPhysicalDeviceMemoryProperties(physicalDevice_, &memory_);
 
     uint32_t familyCount = 0;
@@ -259,6 +362,14 @@ void VulkanContext::createDevice() {
     enabled.accelerationStructure.accelerationStructure = VK_TRUE;
     enabled.rayTracingPipeline.rayTracingPipeline = VK_TRUE;
     enabled.rayTracingPipeline.rayTraversalPrimitiveCulling = available.rayTracingPipeline.rayTraversalPrimitiveCulling;
+    // Texture arrays (unbounded Texture2D ranges) where the device has them; a dispatch that binds one refuses
+    // to run without them (gpu/vulkan_dispatch.cpp).
+    limits_.sampledImageArrays = available.base.features.shaderSampledImageArrayDynamicIndexing &&
+                                 available.vulkan12.runtimeDescriptorArray &&
+                                 available.vulkan12.shaderSampledImageArrayNonUniformIndexing;
+    enabled.base.features.shaderSampledImageArrayDynamicIndexing = limits_.sampledImageArrays;
+    enabled.vulkan12.runtimeDescriptorArray = limits_.sampledImageArrays;
+    enabled.vulkan12.shaderSampledImageArrayNonUniformIndexing = limits_.sampledImageArrays;
 
     const float priority = 1.0f;
     auto queue = vkStruct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);

@@ -19,6 +19,19 @@ struct DeviceInfo {
     std::string driverVersion;  // driverInfo when the driver gives one ("580.159.04"), else the decoded number
     std::string apiVersion;     // the device's Vulkan API version, "1.4.312"
     std::string loader;         // the loader library that was opened
+    std::string type;           // "discrete GPU", "integrated GPU", "virtual GPU", "CPU" (lavapipe), "other"
+    std::string mesaVersion;    // "25.0.7" when the driver is Mesa's (driverInfo "Mesa 25.0.7 ..."), else empty
+    uint32_t index = 0;         // its position in vkEnumeratePhysicalDevices
+};
+
+// One physical device as `refray devices` lists it: what it is and whether refray can ray trace on it.
+struct PhysicalDeviceSummary {
+    uint32_t index = 0;
+    std::string name, type, driverName, driverInfo, apiVersion;
+    bool cpu = false;                   // VK_PHYSICAL_DEVICE_TYPE_CPU: a software driver such as lavapipe, not a GPU
+    bool rayTracing = false;            // qualifies for refray's back end (requiredDeviceExtensions + features)
+    bool rayQuery = false;              // offers VK_KHR_ray_query
+    std::vector<std::string> missing;   // what it lacks for ray tracing (empty when rayTracing)
 };
 
 // The limits of VK_KHR_ray_tracing_pipeline and VK_KHR_acceleration_structure the translation depends on.
@@ -32,6 +45,10 @@ struct RayTracingLimits {
     uint32_t maxUniformBufferRange = 65536;
     float timestampPeriod = 0.0f;  // nanoseconds per timestamp tick; 0: no timestamps on the queue
     bool rayTraversalPrimitiveCulling = false;  // SKIP_TRIANGLES / SKIP_AABBS ray and pipeline flags
+    // Texture2D arrays indexed per ray (`Texture2D t[] : register(t0, space5)`, GLSL `texture2D t[]` with
+    // nonuniformEXT): runtimeDescriptorArray, shaderSampledImageArrayNonUniformIndexing and dynamic indexing.
+    bool sampledImageArrays = false;
+    uint32_t maxBoundDescriptorSets = 4;  // one set per register space in use (CONTRACT.md)
 };
 
 // What a device needs for refray's back end, and why each item is there. The error for a machine without such a
@@ -48,7 +65,20 @@ struct VulkanContextOptions {
     // VK_KHR_ray_tracing_pipeline and VK_KHR_acceleration_structure stay null). For testing buffers, images and
     // descriptor sets on a software device such as lavapipe (tests/gpu/vulkan_memory_test.cpp).
     bool rayTracing = true;
+    // Which physical device: empty picks a hardware ray-tracing device when there is one, else a software one (Mesa's
+    // lavapipe); digits pick vkEnumeratePhysicalDevices' index; anything else the first device whose name or driver
+    // name contains it, case-insensitively ("llvmpipe", "H100"). A device that matches but cannot ray trace, or a
+    // selector that matches none, throws refray::Error listing every device. `refray render --vulkan-device`.
+    std::string device;
 };
+
+// Every Vulkan physical device the loader sees, with what each lacks for refray's ray-tracing back end
+// (`refray devices`). Throws refray::Error when there is no loader or no driver (the same messages as VulkanContext).
+std::vector<PhysicalDeviceSummary> listVulkanDevices();
+
+// The device `selector` picks among `devices` by the rule of VulkanContextOptions::device (for ray tracing), or
+// throws refray::Error saying why none qualifies. A pure function, tested without a GPU.
+uint32_t chooseRayTracingDevice(const std::vector<PhysicalDeviceSummary>& devices, const std::string& selector);
 
 class VulkanContext {
 public:
@@ -56,6 +86,10 @@ public:
     // Throws refray::Error saying exactly what is missing: the loader, a driver, a physical device, or a device
     // with ray tracing (naming each device and what it lacks).
     explicit VulkanContext(const VulkanContextOptions& options = {});
+    // An instance only, for listing its devices.
+    struct InstanceOnly {};
+    explicit VulkanContext(InstanceOnly);
+    std::vector<PhysicalDeviceSummary> summaries() const;
     ~VulkanContext();
     VulkanContext(const VulkanContext&) = delete;
     VulkanContext& operator=(const VulkanContext&) = delete;

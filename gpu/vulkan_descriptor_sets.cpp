@@ -16,6 +16,10 @@ DescriptorSets::DescriptorSets(const VulkanContext& context, const std::vector<D
     const VulkanFunctions& f = context.vk();
     uint32_t setCount = 0;
     for (const DescriptorWrite& w : writes) setCount = std::max(setCount, w.set + 1);
+    // set = register space (CONTRACT.md), so the highest space in use decides how many sets are bound.
+    REFRAY_CHECK(setCount <= context.limits().maxBoundDescriptorSets,
+                 "the global root signature binds registers in space" << setCount - 1 << ", which needs " << setCount
+                     << " descriptor sets; the device binds at most " << context.limits().maxBoundDescriptorSets);
 
     // Layouts.
     std::map<VkDescriptorType, uint32_t> typeCounts;
@@ -26,8 +30,10 @@ DescriptorSets::DescriptorSets(const VulkanContext& context, const std::vector<D
             REFRAY_CHECK(std::none_of(bindings.begin(), bindings.end(),
                                       [&](const VkDescriptorSetLayoutBinding& b) { return b.binding == w.binding; }),
                          "two descriptors at binding " << w.binding << " of set " << set);
-            bindings.push_back({w.binding, w.type, 1, kRayTracingStages, nullptr});
-            ++typeCounts[w.type];
+            REFRAY_CHECK(w.descriptorCount() > 0, "binding " << w.binding << " of set " << set << " holds no descriptors");
+            bindings.push_back({w.binding, w.type, w.descriptorCount(), kRayTracingStages,
+                                w.immutableSampler ? &w.sampler : nullptr});
+            typeCounts[w.type] += w.descriptorCount();
         }
         auto info = vkStruct<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
         info.bindingCount = uint32_t(bindings.size());
@@ -62,17 +68,29 @@ DescriptorSets::DescriptorSets(const VulkanContext& context, const std::vector<D
     std::vector<VkWriteDescriptorSet> updates;
     std::vector<VkDescriptorImageInfo> imageInfos;
     std::vector<VkWriteDescriptorSetAccelerationStructureKHR> asInfos;
-    imageInfos.reserve(writes.size());
+    size_t imageCount = 0;
+    for (const DescriptorWrite& w : writes) imageCount += w.descriptorCount();
+    imageInfos.reserve(imageCount);
     asInfos.reserve(writes.size());
     for (const DescriptorWrite& w : writes) {
+        if (w.immutableSampler) continue;  // the layout holds it
         auto u = vkStruct<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
         u.dstSet = sets_[w.set];
         u.dstBinding = w.binding;
-        u.descriptorCount = 1;
+        u.descriptorCount = w.descriptorCount();
         u.descriptorType = w.type;
         switch (w.type) {
             case VK_DESCRIPTOR_TYPE_STORAGE_IMAGE:
                 imageInfos.push_back({VK_NULL_HANDLE, w.imageView, VK_IMAGE_LAYOUT_GENERAL});
+                u.pImageInfo = &imageInfos.back();
+                break;
+            case VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE:
+                u.pImageInfo = imageInfos.data() + imageInfos.size();
+                for (VkImageView view : w.sampledImages)
+                    imageInfos.push_back({VK_NULL_HANDLE, view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+                break;
+            case VK_DESCRIPTOR_TYPE_SAMPLER:
+                imageInfos.push_back({w.sampler, VK_NULL_HANDLE, VK_IMAGE_LAYOUT_UNDEFINED});
                 u.pImageInfo = &imageInfos.back();
                 break;
             case VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR: {

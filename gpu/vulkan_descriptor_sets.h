@@ -9,7 +9,9 @@
 
 namespace refray::gpu {
 
-// One descriptor with the Vulkan object it names (exactly one of buffer, image view, acceleration structure).
+// One binding with the Vulkan objects it names: a buffer, a storage image view, an acceleration structure, the
+// views of a sampled-image array (SAMPLED_IMAGE: one element per view; the binding's descriptorCount) or a sampler
+// (SAMPLER; `immutableSampler`: baked into the set layout, the mapping of a static sampler, and never written).
 struct DescriptorWrite {
     uint32_t set = 0;
     uint32_t binding = 0;
@@ -17,6 +19,13 @@ struct DescriptorWrite {
     VkDescriptorBufferInfo buffer{};
     VkImageView imageView = VK_NULL_HANDLE;
     VkAccelerationStructureKHR accelerationStructure = VK_NULL_HANDLE;
+    std::vector<VkImageView> sampledImages;
+    VkSampler sampler = VK_NULL_HANDLE;
+    bool immutableSampler = false;
+
+    uint32_t descriptorCount() const {
+        return type == VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE ? uint32_t(sampledImages.size()) : 1u;
+    }
 };
 
 class DescriptorSets {

@@ -11,7 +11,9 @@
 #include "gpu/vulkan_descriptor_sets.h"
 #include "gpu/vulkan_memory.h"
 #include "gpu/vulkan_pipeline.h"
+#include "gpu/vulkan_sampler.h"
 #include "gpu/vulkan_shader_table.h"
+#include "gpu/vulkan_texture.h"
 
 namespace refray::gpu {
 
@@ -43,7 +45,11 @@ std::filesystem::path defaultSpirvDirectory(const std::filesystem::path& executa
 }
 
 VulkanBackend::VulkanBackend(VulkanBackendOptions options)
-    : options_(std::move(options)), context_(std::make_unique<VulkanContext>()) {}
+    : options_(std::move(options)), context_(std::make_unique<VulkanContext>([&] {
+          VulkanContextOptions context;
+          context.device = options_.device;
+          return context;
+      }())) {}
 
 VulkanBackend::~VulkanBackend() = default;
 
@@ -83,6 +89,9 @@ dxr::DispatchResult VulkanBackend::run(dxr::Device& device, const dxr::DispatchR
     AddressMap addresses(context, device.memory());
     std::map<dxr::GpuVirtualAddress, std::unique_ptr<AccelerationStructures>> tlases;
     std::map<Image*, std::unique_ptr<StorageImage>> images;
+    // One upload per texture (an unbounded range may reach into the next table's textures) and per sampler.
+    std::map<const dxr::Texture2D*, std::unique_ptr<SampledTexture>> textures;
+    std::vector<std::unique_ptr<Sampler>> samplers;
     Buffer nullBuffer;
     std::vector<DescriptorWrite> writes;
     for (const DescriptorBinding& b : bindings) {
@@ -106,6 +115,23 @@ dxr::DispatchResult VulkanBackend::run(dxr::Device& device, const dxr::DispatchR
                 w.imageView = image->view();
                 break;
             }
+            case DescriptorBinding::Resource::SampledImages: {
+                REFRAY_CHECK(!b.runtimeArray || limits.sampledImageArrays,
+                             b.what << " is an unbounded texture array; the device lacks what such arrays need "
+                                       "(runtimeDescriptorArray, shaderSampledImageArrayNonUniformIndexing, "
+                                       "shaderSampledImageArrayDynamicIndexing)");
+                for (const dxr::Texture2D* texture : b.textures) {
+                    auto& uploaded = textures[texture];
+                    if (!uploaded) uploaded = std::make_unique<SampledTexture>(context, texture, b.what);
+                    w.sampledImages.push_back(uploaded->view());
+                }
+                break;
+            }
+            case DescriptorBinding::Resource::Sampler:
+                samplers.push_back(std::make_unique<Sampler>(context, b.sampler, b.what));
+                w.sampler = samplers.back()->handle();
+                w.immutableSampler = b.staticSampler;
+                break;
             case DescriptorBinding::Resource::NullBuffer: {
                 if (!nullBuffer.handle()) {
                     const std::vector<uint8_t> zeros(256, 0);

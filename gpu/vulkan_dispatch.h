@@ -26,6 +26,8 @@ struct VulkanBackendOptions {
     // defaults with each ray type's "traceRay" applied), which the GLSL ports read as specialization constants.
     // The host (tools/device_trace_ray.h) fills them in; a dispatch with none refuses to run.
     std::vector<TraceRayConstants> traceRay;
+    // Which Vulkan device (VulkanContextOptions::device): empty for a hardware one when there is one, else lavapipe.
+    std::string device;
 };
 
 // What an AOV dispatch reports per launch index (row-major), each kAovMiss where the primary ray missed.

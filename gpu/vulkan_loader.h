@@ -25,6 +25,7 @@ namespace refray::gpu {
     X(vkGetPhysicalDeviceFeatures2)              \
     X(vkGetPhysicalDeviceQueueFamilyProperties)  \
     X(vkGetPhysicalDeviceMemoryProperties)       \
+    X(vkGetPhysicalDeviceFormatProperties)       \
     X(vkEnumerateDeviceExtensionProperties)      \
     X(vkCreateDevice)                            \
     X(vkGetDeviceProcAddr)
@@ -58,6 +59,8 @@ namespace refray::gpu {
     X(vkBindImageMemory)                             \
     X(vkCreateImageView)                             \
     X(vkDestroyImageView)                            \
+    X(vkCreateSampler)                               \
+    X(vkDestroySampler)                              \
     X(vkCmdCopyBuffer)                               \
     X(vkCmdCopyBufferToImage)                        \
     X(vkCmdCopyImageToBuffer)                        \

@@ -131,6 +131,14 @@ int runDiscriminate(const GoldenCommandOptions& o) {
         const fs::path self = fs::read_symlink("/proc/self/exe", ec);
         if (!ec && fs::exists(self.parent_path() / "refray-fma")) options.fusedRefray = self.parent_path() / "refray-fma";
     }
+#ifdef REFRAY_HAVE_VULKAN
+    {
+        // The 'lavapipe' candidate: this refray, on Mesa's lavapipe (--vulkan-device llvmpipe).
+        std::error_code ec;
+        const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+        if (!ec) options.vulkanRefray = self;
+    }
+#endif
     options.onRow = [](const scenes::DiscriminationRow& r) {
         std::printf("%-44s %-26s %-8s %-12s", r.golden.c_str(), r.candidate.name.c_str(),
                     r.candidate.kind == scenes::CandidateKind::Correct ? "correct" : "mutant",

@@ -187,6 +187,7 @@ struct RenderOptions {
     std::vector<std::string> knobs;  // "name=value"
     std::string device = "cpu";      // --device: where DispatchRays runs (tools/render_device.h)
     std::string spirvDir;            // --spirv-dir
+    std::string vulkanDevice;        // --vulkan-device
 };
 
 bool endsWithExr(const std::string& path) {
@@ -315,7 +316,7 @@ int runRender(const RenderOptions& o) {
                      "files");
         const Size size = parseSize(o.size.empty() ? "640x360" : o.size);
         settings.width = size.width, settings.height = size.height;
-        device = tools::useRenderDevice(o.device, "builtin", nullptr, o.spirvDir, settings);
+        device = tools::useRenderDevice(o.device, "builtin", nullptr, o.spirvDir, o.vulkanDevice, settings);
         scenes::BuiltinScene scene;
         const auto renderOnce = [&](const scenes::RenderSettings& s) {
             scenes::RenderResult r = scene.render(s);
@@ -332,7 +333,8 @@ int runRender(const RenderOptions& o) {
         effects = effectSet.list();
         const Size size = o.size.empty() ? Size{scene->desc().defaultWidth, scene->desc().defaultHeight} : parseSize(o.size);
         settings.width = size.width, settings.height = size.height;
-        device = tools::useRenderDevice(o.device, scene->desc().shaderLibrary, &scene->desc(), o.spirvDir, settings);
+        device = tools::useRenderDevice(o.device, scene->desc().shaderLibrary, &scene->desc(), o.spirvDir,
+                                        o.vulkanDevice, settings);
         if (!o.aov.empty()) {
             renderIndexMap(*scene, settings, o, device);
             return 0;
@@ -463,6 +465,10 @@ int main(int argc, char** argv) {
                        "Where DispatchRays runs: cpu (the emulator) or vulkan (the same DXR state translated to a Vulkan "
                        "ray-tracing GPU; docs/vulkan-backend.md)")
         ->capture_default_str();
+    render->add_option("--vulkan-device", ro.vulkanDevice,
+                       "With --device vulkan: which Vulkan device, by index or by part of its device or driver name "
+                       "('refray devices' lists them; default $REFRAY_VULKAN_DEVICE, else a hardware ray-tracing "
+                       "device when there is one and Mesa's lavapipe, a CPU driver, otherwise)");
     render->add_option("--spirv-dir", ro.spirvDir,
                        "With --device vulkan: the folder of the compiled GLSL ports (<library>/<Export>.<stage>.spv); "
                        "default $REFRAY_SPIRV_DIR, else next to the refray executable");
@@ -486,6 +492,12 @@ int main(int argc, char** argv) {
     refray::tools::GoldenCommandOptions goldenOptions;
     CLI::App* golden = refray::tools::addGoldenCommand(app, goldenOptions);
 
+    auto* devices = app.add_subcommand("devices", "List the Vulkan devices refray sees, whether each can ray trace "
+                                                  "(and what it lacks), and which one --device vulkan takes; exit 2 "
+                                                  "when none can");
+    bool devicesJson = false;
+    devices->add_flag("--json", devicesJson, "Print the list as JSON (format refray-devices/1)");
+
     try {
         app.parse(argc, argv);
         if (*golden) return refray::tools::runGolden(goldenOptions);
@@ -494,6 +506,7 @@ int main(int argc, char** argv) {
         if (*table) return refray::tools::runTable(tableOptions);
         if (*explain) return refray::tools::runExplain(explainOptions);
         if (*sweep) return refray::tools::runSweep(sweepOptions);
+        if (*devices) return refray::tools::listDevices(devicesJson);
     } catch (const CLI::ParseError& e) {
         return refray::tools::parseErrorStatus(app, e);
     } catch (const refray::dxr::DxrError& e) {

@@ -1,9 +1,12 @@
 #include "tools/render_device.h"
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <optional>
 
 #include "core/error.h"
+#include "core/json_writer.h"
 
 #ifdef REFRAY_HAVE_VULKAN
 #include "gpu/vulkan_dispatch.h"
@@ -12,17 +15,29 @@
 
 namespace refray::tools {
 
+namespace {
+
+std::string vulkanDeviceSelector(const std::string& option) {
+    if (!option.empty()) return option;
+    const char* env = std::getenv("REFRAY_VULKAN_DEVICE");
+    return env ? env : "";
+}
+
+}  // namespace
+
 RenderDevice makeRenderDevice(const std::string& device, const std::string& library, const scenes::SceneDesc* scene,
-                              const std::string& spirvDirectory) {
+                              const std::string& spirvDirectory, const std::string& vulkanDevice) {
     REFRAY_CHECK(device == "cpu" || device == "vulkan", "--device expects 'cpu' or 'vulkan', got '" << device << "'");
     RenderDevice out;
     if (device == "cpu") {
         REFRAY_CHECK(spirvDirectory.empty(), "--spirv-dir is for --device vulkan");
+        REFRAY_CHECK(vulkanDevice.empty(), "--vulkan-device is for --device vulkan");
         return out;
     }
 #ifdef REFRAY_HAVE_VULKAN
     gpu::VulkanBackendOptions options;
     options.library = library;
+    options.device = vulkanDeviceSelector(vulkanDevice);
     options.traceRay = deviceTraceRayConstants(library, scene);
     options.spirvDirectory = spirvDirectory.empty()
                                  ? gpu::defaultSpirvDirectory(std::filesystem::read_symlink("/proc/self/exe"))
@@ -54,12 +69,15 @@ RenderDevice makeRenderDevice(const std::string& device, const std::string& libr
     out.provenance["device"] = "vulkan";
     out.provenance["gpu"] = info.name;
     out.provenance["gpu_driver"] = info.driverName + " " + info.driverVersion;
+    out.provenance["vulkan_device_type"] = info.type;  // "CPU" for lavapipe: a software driver, not a GPU
+    out.provenance["vulkan_device_index"] = std::to_string(info.index);
+    if (!info.mesaVersion.empty()) out.provenance["mesa_version"] = info.mesaVersion;
     out.provenance["vulkan_api"] = info.apiVersion;
     out.provenance["spirv_dir"] = options.spirvDirectory.string();
     out.state = backend;
     return out;
 #else
-    (void)library, (void)scene;
+    (void)library, (void)scene, (void)vulkanDevice;
     throw Error("--device vulkan: this refray was built without the Vulkan back end (configure found no "
                 "libvulkan-dev, glslang-tools or spirv-tools, or REFRAY_VULKAN=OFF)");
 #endif
@@ -114,11 +132,70 @@ void checkVulkanSettings(const scenes::RenderSettings& settings) {
 }
 
 RenderDevice useRenderDevice(const std::string& device, const std::string& library, const scenes::SceneDesc* scene,
-                             const std::string& spirvDirectory, scenes::RenderSettings& settings) {
+                             const std::string& spirvDirectory, const std::string& vulkanDevice,
+                             scenes::RenderSettings& settings) {
     if (device == "vulkan") checkVulkanSettings(settings);
-    RenderDevice out = makeRenderDevice(device, library, scene, spirvDirectory);
+    RenderDevice out = makeRenderDevice(device, library, scene, spirvDirectory, vulkanDevice);
     settings.backend = out.backend;
     return out;
+}
+
+int listDevices(bool json) {
+#ifdef REFRAY_HAVE_VULKAN
+    const std::vector<gpu::PhysicalDeviceSummary> devices = gpu::listVulkanDevices();
+    std::optional<uint32_t> chosen;
+    std::string why;
+    try {
+        chosen = gpu::chooseRayTracingDevice(devices, vulkanDeviceSelector(""));
+    } catch (const Error& e) {
+        why = e.what();
+    }
+    if (json) {
+        json::Writer w;
+        w.beginObject().member("format", "refray-devices/1").key("devices").beginArray();
+        for (const gpu::PhysicalDeviceSummary& d : devices) {
+            w.beginObject()
+                .member("index", d.index)
+                .member("name", d.name)
+                .member("type", d.type)
+                .member("software", d.cpu)
+                .member("driver", d.driverName)
+                .member("driverInfo", d.driverInfo)
+                .member("vulkanApi", d.apiVersion)
+                .member("rayTracing", d.rayTracing)
+                .member("rayQuery", d.rayQuery)
+                .member("default", chosen && *chosen == d.index)
+                .key("lacks")
+                .beginArray(json::Writer::Layout::Inline);
+            for (const std::string& m : d.missing) w.value(m);
+            w.endArray().endObject();
+        }
+        w.endArray().endObject();
+        std::printf("%s\n", w.text().c_str());
+    } else {
+        std::printf("%-5s %-40s %-14s %-12s %-8s %-9s %s\n", "index", "device", "type", "driver", "Vulkan", "rayQuery",
+                    "ray tracing");
+        for (const gpu::PhysicalDeviceSummary& d : devices) {
+            std::string rt = d.rayTracing ? "yes" : "no: lacks ";
+            if (!d.rayTracing)
+                for (size_t i = 0; i < d.missing.size(); ++i) rt += (i ? ", " : "") + d.missing[i];
+            if (chosen && *chosen == d.index) rt += "   <- --device vulkan";
+            std::printf("%-5u %-40s %-14s %-12s %-8s %-9s %s\n", d.index, d.name.c_str(), d.type.c_str(),
+                        d.driverName.c_str(), d.apiVersion.c_str(), d.rayQuery ? "yes" : "no", rt.c_str());
+        }
+        for (const gpu::PhysicalDeviceSummary& d : devices)
+            if (d.cpu) std::printf("device %u (%s, %s) is a CPU driver, not a GPU\n", d.index, d.name.c_str(), d.driverInfo.c_str());
+    }
+    if (!chosen) {
+        std::fprintf(stderr, "refray: %s\n", why.c_str());
+        return 2;
+    }
+    return 0;
+#else
+    (void)json;
+    throw Error("refray devices: this refray was built without the Vulkan back end (configure found no "
+                "libvulkan-dev, glslang-tools or spirv-tools, or REFRAY_VULKAN=OFF)");
+#endif
 }
 
 }  // namespace refray::tools

@@ -30,13 +30,21 @@ struct RenderDevice {
 // specialization constants (tools/device_trace_ray.h); `spirvDirectory` the --spirv-dir option (empty:
 // REFRAY_SPIRV_DIR or next to the executable). Throws refray::Error when the device is unknown, when this refray was
 // built without the Vulkan back end, when the TraceRay arguments cannot be determined, or when no ray-tracing device
-// is found (the message says what is missing).
+// is found (the message says what is missing). `vulkanDevice` is the --vulkan-device option (empty:
+// $REFRAY_VULKAN_DEVICE, else a hardware ray-tracing device when there is one and Mesa's lavapipe otherwise;
+// gpu::VulkanContextOptions::device).
 RenderDevice makeRenderDevice(const std::string& device, const std::string& library, const scenes::SceneDesc* scene,
-                              const std::string& spirvDirectory);
+                              const std::string& spirvDirectory, const std::string& vulkanDevice = "");
 
 // makeRenderDevice, and for `vulkan` checkVulkanSettings(settings); sets settings.backend.
 RenderDevice useRenderDevice(const std::string& device, const std::string& library, const scenes::SceneDesc* scene,
-                             const std::string& spirvDirectory, scenes::RenderSettings& settings);
+                             const std::string& spirvDirectory, const std::string& vulkanDevice,
+                             scenes::RenderSettings& settings);
+
+// `refray devices [--json]`: every Vulkan device the loader sees, whether refray can ray trace on it (and what it
+// lacks), whether it has ray queries, and which one `--device vulkan` takes. Returns the exit status: 0 when at least
+// one device can ray trace, 2 when none can or there is no loader or driver (the message says what is missing).
+int listDevices(bool json);
 
 // `refray render --aov KIND`: the index map of each pixel's primary ray, from the emulator's trace
 // (scenes::renderIndexMap) or, on a device with `aov`, from its AOV dispatch. The device reports the record index it

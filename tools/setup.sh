@@ -17,6 +17,7 @@ packages=(
   python3  # tools/make_discrimination_report.sh and the GPU round's scripts write their tables with it
   slurm-wlm munge  # a single-node Slurm cluster runs the lines of 'refray golden update --emit-jobs' (a test starts it)
   libvulkan-dev glslang-tools spirv-tools  # the Vulkan back end (gpu/): headers, loader, GLSL -> SPIR-V, spirv-val
+  ccache  # every preset compiles through it (CMakePresets.json); its cache lives outside the clone (~/.cache/ccache)
 )
 
 missing=()
@@ -28,16 +29,26 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#packages[@]} packages present"
-  exit 0
+else
+  if [ "$(id -u)" -ne 0 ]; then
+    echo "setup: missing packages: ${missing[*]}" >&2
+    echo "setup: run as root (or install them with apt-get) and try again" >&2
+    exit 1
+  fi
+  echo "setup: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-if [ "$(id -u)" -ne 0 ]; then
-  echo "setup: missing packages: ${missing[*]}" >&2
-  echo "setup: run as root (or install them with apt-get) and try again" >&2
-  exit 1
-fi
+# Mesa's lavapipe: a CPU Vulkan driver with VK_KHR_ray_tracing_pipeline and VK_KHR_ray_query
+# (Mesa >= 25 from Debian's bookworm-backports). The Lavapipe* tests run refray's Vulkan back end on it.
+bash "$(dirname "$0")/setup_lavapipe.sh"
 
-echo "setup: installing ${missing[*]}"
-export DEBIAN_FRONTEND=noninteractive
-apt-get update -qq
-apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# ccache keeps the objects of every preset (ci and asan-ubsan builds of one commit are about 3 GB).
+if command -v ccache >/dev/null 2>&1; then
+  current=$(ccache -k max_size 2>/dev/null || echo "")
+  if [ "$current" != "20.0G" ] && [ "$current" != "20.0 GB" ] && [ "$current" != "20G" ]; then
+    ccache --max-size 20G >/dev/null && echo "setup: ccache max size set to 20G"
+  fi
+fi

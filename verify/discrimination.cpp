@@ -5,9 +5,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <map>
 #include <sstream>
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "core/error.h"
@@ -43,6 +45,10 @@ std::vector<DiscriminationCandidate> makeCandidates() {
     c.push_back({"fma-contraction", K::Correct,
                  "refray built with fused multiply-add: the compiler contracts a*b+c wherever it likes, as GPU compilers do",
                  "the refray-fma binary (shader libraries compiled with -mfma -ffp-contract=fast)"});
+    c.push_back({"lavapipe", K::Correct,
+                 "Mesa's lavapipe (a CPU Vulkan driver, not a GPU) running refray's Vulkan back end and GLSL ports: a "
+                 "second implementation of traversal and of every shader",
+                 "refray render --device vulkan --vulkan-device llvmpipe"});
 
     // Mutants: shader constants a port gets wrong (knobs).
     const std::pair<const char*, const char*> knobs[] = {
@@ -216,24 +222,39 @@ Image mutateImage(const Image& in, const std::string& name) {
 
 bool startsWith(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
 
-// refray-fma renders the golden's settings into a temporary EXR.
-Image renderFused(const DiscriminationOptions& o, const GoldenEntry& e, DiscriminationRow& row) {
+// Another refray process renders the golden's settings into a temporary EXR: refray-fma, or refray on lavapipe.
+Image renderByProcess(const DiscriminationOptions& o, const GoldenEntry& e, DiscriminationRow& row,
+                      const fs::path& binary, const std::string& extraArguments, const std::string& label,
+                      const std::string& whenMissing) {
     std::string& error = row.error;
-    if (o.fusedRefray.empty()) {
+    if (binary.empty()) {
         row.unavailable = true;
-        error = "no refray-fma binary given (--fma-refray, or build the refray-fma target)";
+        error = whenMissing;
         return {};
     }
-    const fs::path out = fs::temp_directory_path() / ("refray-fma-" + std::to_string(::getpid()) + "-" + e.name + ".exr");
-    const std::string command = shellQuoted(o.fusedRefray.string()) + " render " +
+    const fs::path out = fs::temp_directory_path() / (label + "-" + std::to_string(::getpid()) + "-" + e.name + ".exr");
+    const fs::path log = fs::path(out).replace_extension(".log");
+    const std::string command = shellQuoted(binary.string()) + " render " +
                                 shellQuoted((o.repositoryRoot / e.scene).string()) + " --camera " +
                                 shellQuoted(e.camera) + " --time " + shellQuoted(e.time) + " --size " +
                                 std::to_string(e.width) + "x" + std::to_string(e.height) + " --precision " +
-                                e.precision + " --threads " + std::to_string(o.threads) + " -o " +
-                                shellQuoted(out.string()) + " > /dev/null";
+                                e.precision + " --threads " + std::to_string(o.threads) + extraArguments + " -o " +
+                                shellQuoted(out.string()) + " > " + shellQuoted(log.string()) + " 2>&1";
     const int status = std::system(command.c_str());
+    std::string said;
+    {
+        std::ifstream in(log);
+        std::getline(in, said, '\0');
+    }
+    fs::remove(log);
     if (status != 0) {
-        error = "refray-fma exited with status " + std::to_string(status) + ": " + command;
+        // A missing Vulkan device is the machine's, not the candidate's: reported as not run.
+        if (said.find("no Vulkan") != std::string::npos || said.find("no Vulkan device matches") != std::string::npos)
+            row.unavailable = true;
+        while (!said.empty() && (said.back() == '\n' || said.back() == ' ')) said.pop_back();
+        error = label + " exited with status " + std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : status) +
+                (said.empty() ? "" : ": " + said);
+        fs::remove(out);
         return {};
     }
     Image image = readImage(out.string());
@@ -288,7 +309,16 @@ std::vector<DiscriminationRow> runDiscrimination(const DiscriminationOptions& o)
                     s.adversarialSeed = std::stoul(n.substr(11));
                     image = scene->render(s).image;
                 } else if (n == "fma-contraction") {
-                    image = renderFused(o, entry, row);
+                    image = renderByProcess(o, entry, row, o.fusedRefray, "", "refray-fma",
+                                            "no refray-fma binary given (--fma-refray, or build the refray-fma target)");
+                } else if (n == "lavapipe") {
+                    const char* device = std::getenv("REFRAY_LAVAPIPE_DEVICE");
+                    image = renderByProcess(o, entry, row, o.vulkanRefray,
+                                            " --device vulkan --vulkan-device " +
+                                                shellQuoted(device && *device ? device : "llvmpipe"),
+                                            "lavapipe",
+                                            "no refray with the Vulkan back end given (--vulkan-refray; this refray "
+                                            "was built without it)");
                 } else if (startsWith(c.how, "--knob ")) {
                     applyKnobAssignment(s, c.how.substr(7));
                     image = scene->render(s).image;

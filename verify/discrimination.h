@@ -38,6 +38,9 @@ struct DiscriminationOptions {
     // refray built with FMA contraction of the shader libraries (the refray-fma target); empty: that candidate is
     // reported as not run, with the reason.
     std::filesystem::path fusedRefray;
+    // refray built with the Vulkan back end, for the 'lavapipe' candidate (Mesa's lavapipe, a CPU Vulkan driver,
+    // runs its GLSL ports); empty, or no lavapipe on the machine: that candidate is reported as not run.
+    std::filesystem::path vulkanRefray;
     std::vector<std::string> only;     // candidate names to run; empty: all
     std::vector<std::string> goldens;  // golden names to judge; empty: all
     std::function<void(const struct DiscriminationRow&)> onRow;  // after each judgement (progress)

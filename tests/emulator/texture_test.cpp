@@ -223,6 +223,23 @@ TEST(Texture2D, LoadReadsOneTexelAndZerosOutOfRange) {
     EXPECT_EQ(t->Load({0, 0}, -1), vec4(0.0f));
 }
 
+TEST(Texture2D, ReadLevelGivesEveryTexelAsLoadDoes) {
+    std::vector<float> texels;
+    for (int i = 0; i < 16; ++i) texels.insert(texels.end(), {float(i), float(i % 4), 0.0f, 1.0f});
+    const auto t = Texture2D::fromFile(writeTexture("readlevel_4x4.exr", 4, 4, 4, texels));
+    for (uint32_t level = 0; level < t->mipLevels(); ++level) {
+        const std::vector<vec4> all = t->readLevel(level);
+        ASSERT_EQ(all.size(), size_t(t->width(level)) * t->height(level)) << level;
+        for (uint32_t y = 0; y < t->height(level); ++y)
+            for (uint32_t x = 0; x < t->width(level); ++x)
+                EXPECT_EQ(all[y * t->width(level) + x], t->Load(ivec2(x, y), int(level))) << level << " " << x << " " << y;
+    }
+    // A grey sRGB file expands and decodes as Load does.
+    const auto grey = Texture2D::fromFile(writeTexture("readlevel_grey.png", 2, 1, 1, {0.2f, 0.8f}), /*sRGB=*/true);
+    EXPECT_EQ(grey->readLevel(0), (std::vector<vec4>{grey->Load({0, 0}), grey->Load({1, 0})}));
+    EXPECT_THROW(t->readLevel(t->mipLevels()), Error);
+}
+
 TEST(Texture2D, ChannelsExpandToRgbaAndSrgbDecodesColourOnly) {
     const auto grey = Texture2D::fromFile(writeTexture("grey.png", 1, 1, 1, {51 / 255.0f}));
     EXPECT_EQ(grey->fileChannels(), 1u);

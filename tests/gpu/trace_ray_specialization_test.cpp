@@ -89,6 +89,17 @@ TEST(VulkanTraceRaySpecialization, ReferenceScenesGiveTheHlslArguments) {
               (std::vector<TraceRayConstants>{{0, 2, 0, 0xFF}, {1, 2, 1, 0xFF}}));
 }
 
+// The path tracer's scenes: the C++ library's fixed arguments (R = ray type, M = 2, miss = ray type, mask 0xFF), which
+// are also the GLSL port's defaults (gpu/shaders/dxr-path-tracer/pathtracer.glsl).
+TEST(VulkanTraceRaySpecialization, PathTracerScenesGiveTheLibrarysFixedArguments) {
+    for (const char* file : {"cornell-box.json", "textured-room.json"}) {
+        SCOPED_TRACE(file);
+        const scenes::SceneDesc scene = scenes::loadSceneFile(kScenes / file);
+        EXPECT_EQ(deviceTraceRayConstants(scene.shaderLibrary, &scene),
+                  (std::vector<TraceRayConstants>{{0, 2, 0, 0xFF}, {1, 2, 1, 0xFF}}));
+    }
+}
+
 TEST(VulkanTraceRaySpecialization, RefusesWhatItCannotDetermine) {
     EXPECT_THROW(deviceTraceRayConstants("d3d12-procedural-geometry", nullptr), Error);
     const scenes::SceneDesc d3d12 = scenes::loadSceneFile(kScenes / "d3d12-procedural-geometry.json");
@@ -103,7 +114,7 @@ TEST(VulkanTraceRaySpecialization, RefusesWhatItCannotDetermine) {
 TEST(VulkanTraceRaySpecialization, EveryTraceRayReadsSpecializationConstants) {
     constexpr uint32_t kOpDecorate = 71, kDecorationSpecId = 1, kOpTraceRayKHR = 4445;
     size_t traces = 0;
-    for (const char* library : {"builtin", "d3d12-procedural-geometry", "proceduray"}) {
+    for (const char* library : {"builtin", "d3d12-procedural-geometry", "proceduray", "dxr-path-tracer"}) {
         for (const fs::directory_entry& f : fs::directory_iterator(fs::path(REFRAY_SPIRV_DIR) / library)) {
             if (f.path().extension() != ".spv") continue;
             SCOPED_TRACE(f.path().string());

@@ -18,7 +18,7 @@ class VulkanMemory : public ::testing::Test {
 protected:
     void SetUp() override {
         try {
-            context = std::make_unique<VulkanContext>(VulkanContextOptions{false});
+            context = std::make_unique<VulkanContext>(VulkanContextOptions{false, {}});
         } catch (const Error& e) {
             GTEST_SKIP() << "no Vulkan device here: " << e.what();
         }
