@@ -2,7 +2,8 @@
 """The planning and bookkeeping half of tools/gpu_crosscheck.sh (standard library only: it runs on the GPU machine).
 
   gpu_crosscheck.py plan ROOT SIZE          what to render: one tab-separated line per render
-                                            (what, name, scene, camera, time, size, precision, aov, output)
+                                            (what, name, scene, camera, time, size, precision, aov, output,
+                                            extra refray arguments or "-")
   gpu_crosscheck.py metadata FILE.exr       the refray:* attributes of an EXR's header, as JSON
   gpu_crosscheck.py provenance DIR          writes DIR/provenance.json from DIR/plan.tsv, DIR/commands.txt,
                                             DIR/speed.tsv and the renders' headers
@@ -15,7 +16,9 @@ import struct
 import subprocess
 import sys
 
-AOVS = ["record", "instance", "geometry", "primitive"]
+AOVS = ["record", "instance", "geometry", "primitive", "hitgroup"]
+# The path tracer's statistical goldens are re-rendered on the GPU with seeds the golden was not made from.
+STATS_FIRST_SEED = 100
 SPEED_SIZE = "1280x720"
 
 
@@ -24,10 +27,16 @@ def plan(root, size):
     rows = []
     for g in goldens:
         setting = [g["scene"], g["camera"], g["time"], "%dx%d" % (g["width"], g["height"]), g["precision"]]
-        rows.append(["image", g["name"]] + setting + ["-", "images/%s.exr" % g["name"]])
+        rows.append(["image", g["name"]] + setting + ["-", "images/%s.exr" % g["name"], "-"])
         for aov in AOVS:
-            rows.append(["map", g["name"]] + setting[:3] + [size, "float", aov, "maps/%s.%s.exr" % (g["name"], aov)])
-        rows.append(["speed", g["name"]] + setting[:3] + [SPEED_SIZE, g["precision"], "-", "-"])
+            rows.append(["map", g["name"]] + setting[:3] + [size, "float", aov, "maps/%s.%s.exr" % (g["name"], aov), "-"])
+        rows.append(["speed", g["name"]] + setting[:3] + [SPEED_SIZE, g["precision"], "-", "-", "-"])
+    # Path-traced scenes: a statistics image (--batches) at the statistical golden's settings, other seeds.
+    manifest = json.load(open(os.path.join(root, "tests/golden/goldens.json")))
+    for g in manifest.get("statistical", []):
+        extra = "--spp %d --batches %d --seed %d" % (g["spp"], g["batches"], STATS_FIRST_SEED)
+        rows.append(["stats", g["name"], g["scene"], g["camera"], "-", "%dx%d" % (g["width"], g["height"]), "float",
+                     "-", "images/%s.stats.exr" % g["name"], extra])
     # The lessons that render: their own camera, the scene's default time.
     for path in sorted(glob.glob(os.path.join(root, "scenes/lessons/*.json"))):
         lesson = json.load(open(path))
@@ -38,7 +47,7 @@ def plan(root, size):
         scene = os.path.relpath(path, root)
         for aov in AOVS:
             rows.append(["map", name, scene, render.get("camera", "-"), "-", size, "float", aov,
-                         "maps/%s.%s.exr" % (name, aov)])
+                         "maps/%s.%s.exr" % (name, aov), "-"])
     for r in rows:
         print("\t".join(str(x) for x in r))
 
@@ -66,11 +75,18 @@ def exr_attributes(path):
 def provenance(directory):
     renders = []
     for line in open(os.path.join(directory, "plan.tsv")):
-        what, name, scene, camera, time, size, precision, aov, output = line.rstrip("\n").split("\t")
+        fields = line.rstrip("\n").split("\t")
+        what, name, scene, camera, time, size, precision, aov, output = fields[:9]
+        extra = fields[9] if len(fields) > 9 else "-"
         if what == "speed":
             continue
         entry = {"what": what, "name": name, "scene": scene, "camera": camera, "time": time, "size": size,
                  "precision": precision, "file": output}
+        if extra != "-":
+            words = extra.split()
+            for key in ("spp", "batches", "seed"):
+                if "--" + key in words:
+                    entry[key] = int(words[words.index("--" + key) + 1])
         if aov != "-":
             entry["aov"] = aov
         path = os.path.join(directory, output)

@@ -7,7 +7,9 @@
 #   renders, through tools/gpu_run.sh:
 #     images/NAME.exr           every golden of tests/golden/goldens.json at its own settings (scene, camera, time,
 #                               size, precision)
-#     maps/NAME.KIND.exr        the index maps record, instance, geometry, primitive (exact values, -1 for a miss:
+#     images/NAME.stats.exr     every statistical golden (the path tracer) re-rendered as a statistics image
+#                               (--spp, --batches of the golden, seeds from 100: not the golden's)
+#     maps/NAME.KIND.exr        the index maps record, instance, geometry, primitive, hitgroup (exact values, -1 for a miss:
 #                               refray render --aov KIND -o FILE.exr) of every golden's setting at the golden size,
 #                               and of every lesson in scenes/lessons/ whose render is defined (its camera)
 #     speed.tsv                 every golden setting at 1280x720, 3 times: render_seconds (the GPU's trace time)
@@ -43,6 +45,7 @@ import json, sys
 dest = sys.argv[1]
 p = json.load(open(dest + "/provenance.json"))
 images = [r for r in p["renders"] if r["what"] == "image" and r["rendered"]]
+stats = [r for r in p["renders"] if r["what"] == "stats" and r["rendered"]]
 maps = [r for r in p["renders"] if r["what"] == "map" and r["rendered"]]
 missing = [r["file"] for r in p["renders"] if not r["rendered"]]
 open(dest + "/README.md", "w").write(f"""# Renders made on a GPU (not by refray's CPU emulator)
@@ -56,7 +59,9 @@ They change only when a new GPU round is imported, never when the goldens change
 - `images/NAME.exr` ({len(images)}): each golden of tests/golden/goldens.json at its own settings, as the GPU
   rendered it (float RGBA). Checked against the golden with its order mask, within the per-scene bound of
   docs/gpu-crosscheck.md.
-- `maps/NAME.KIND.exr` ({len(maps)}): the index maps (record, instance, geometry, primitive) of each pixel's primary
+- `images/NAME.stats.exr` ({len(stats)}): each statistical golden's path-traced scene as the GPU rendered it, a
+  statistics image (`--spp`, `--batches` of the golden, seeds from 100), judged with `refray compare --statistical`.
+- `maps/NAME.KIND.exr` ({len(maps)}): the index maps (record, instance, geometry, primitive, hitgroup) of each pixel's primary
   ray as the GPU's AOV dispatch reported them: R = G = B = the index, -1 for a miss, exact in float32. Checked
   to equal refray's CPU maps of the same settings outside order-dependent pixels.
 - `provenance.json`: the GPU, driver, Vulkan API, date, refray commit, the command lines, every render's settings,
@@ -93,7 +98,7 @@ gpu_render() {
   fi
 }
 
-while IFS=$'\t' read -r what name scene camera time wh precision aov output; do
+while IFS=$'\t' read -r what name scene camera time wh precision aov output extra; do
   args=("$scene" --size "$wh")
   [ "$camera" != "-" ] && args+=(--camera "$camera")
   [ "$time" != "-" ] && args+=(--time "$time")
@@ -101,6 +106,10 @@ while IFS=$'\t' read -r what name scene camera time wh precision aov output; do
     image)
       echo "== image $name ($(( $(date +%s) - start )) s)"
       gpu_render "${args[@]}" --precision "$precision" -o "$dir/$output" || true ;;
+    stats)
+      echo "== statistics image $name $extra ($(( $(date +%s) - start )) s)"
+      read -r -a more <<<"$extra"
+      gpu_render "${args[@]}" "${more[@]}" -o "$dir/$output" || true ;;
     map)
       echo "== map $name $aov ($(( $(date +%s) - start )) s)"
       gpu_render "${args[@]}" --aov "$aov" -o "$dir/$output" || true ;;

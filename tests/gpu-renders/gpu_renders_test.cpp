@@ -14,6 +14,7 @@
 #include "core/envelope.h"
 #include "core/image.h"
 #include "core/json.h"
+#include "core/statistical_compare.h"
 #include "inspect/index_map.h"
 #include "inspect/map_crosscheck.h"
 #include "scenes/scene.h"
@@ -142,6 +143,35 @@ TEST(GpuRenders, EveryImagePassesItsEnvelopeGolden) {
                       << j.describe(20) << "  GPU render and heat map written to " << out.string();
     }
     EXPECT_GT(judged, 0u) << "the round recorded no image";
+}
+
+// The path tracer on a GPU: each statistical golden's scene, re-rendered on the GPU as a statistics image with other
+// seeds (tools/gpu_crosscheck.sh, `--spp S --batches K --seed 100`), must pass `refray compare --statistical` against
+// the CPU emulator's golden (docs/compare.md, "Statistical comparison"). A round recorded before the GPU ran the path
+// tracer has no such render: the test then says so and checks nothing else.
+TEST(GpuRenders, EveryPathTracedRenderPassesItsStatisticalGolden) {
+    const std::vector<StatisticalGoldenEntry> goldens = readGoldenManifest(kGoldens / "goldens.json").statistical;
+    uint64_t judged = 0;
+    for (const Recorded& r : round().renders) {
+        if (r.what != "stats") continue;
+        SCOPED_TRACE(r.name);
+        const auto golden = std::find_if(goldens.begin(), goldens.end(),
+                                         [&](const StatisticalGoldenEntry& g) { return g.name == r.name; });
+        ASSERT_NE(golden, goldens.end()) << "no statistical golden named " << r.name << " in tests/golden/goldens.json";
+        const StatisticsImage reference = readStatisticsImage((kGoldens / golden->image).string());
+        const StatisticsImage candidate = readStatisticsImage((kRenders / r.file).string());
+        EXPECT_EQ(candidate.mean.metadata.at("device"), "vulkan") << r.file << " is not a device render";
+        const StatisticalCompareResult result = compareStatistics(reference, candidate);
+        ++judged;
+        std::printf("%s: %llu of %llu pixel-channel tests below the corrected threshold %.3g; smallest p %.3g\n",
+                    r.name.c_str(), (unsigned long long)result.failingTests, (unsigned long long)result.tests,
+                    result.threshold, result.smallest.test.p);
+        EXPECT_EQ(result.verdict, CompareVerdict::Pass) << r.name << ": the GPU's path-traced render fails its "
+                                                        << "statistical golden " << golden->image << "\n"
+                                                        << result.describe();
+    }
+    if (judged == 0)
+        std::printf("this GPU round (%s) recorded no path-traced render\n", member(round().provenance, "date").c_str());
 }
 
 }  // namespace
