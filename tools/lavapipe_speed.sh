@@ -28,7 +28,6 @@ if [ -z "$refray" ]; then
   done
 fi
 [ -n "$refray" ] && [ -x "$refray" ] || { echo "lavapipe_speed: no refray binary: build one (bash tools/refray.sh --help)" >&2; exit 1; }
-"$refray" devices > /dev/null 2>&1 || true
 if ! "$refray" devices 2>/dev/null | grep -q llvmpipe; then
   echo "lavapipe_speed: Mesa's lavapipe is missing; install it with: bash tools/setup.sh (as root)" >&2
   exit 1
@@ -46,28 +45,35 @@ for g in json.load(open("tests/golden/goldens.json"))["goldens"]:
 PY
 )
 
-# run_once DEVICE NAME SCENE CAMERA TIME -> "TRACE_SECONDS PROCESS_SECONDS"
+# run_once DEVICE NAME SCENE CAMERA TIME: sets $trace (the image's render_seconds: refray's DispatchRays wall time,
+# or on lavapipe the vkCmdTraceRaysKHR time from its timestamps) and $process (the whole command's wall time).
 run_once() {
-  local device=$1 name=$2 scene=$3 camera=$4 time=$5 extra=() log start end trace
+  local device=$1 name=$2 scene=$3 camera=$4 time=$5 extra=() log start end image
   [ "$device" = lavapipe ] && extra=(--device vulkan --vulkan-device llvmpipe)
   log=$work/$name.$device.log
+  image=$work/$name.$device.exr
   start=$(date +%s.%N)
-  "$refray" render "$scene" --camera "$camera" --time "$time" --size "$size" --threads "$threads" "${extra[@]}" \
-    -o "$work/$name.$device.exr" > "$log" 2>&1 || { echo "lavapipe_speed: $device failed on $name:" >&2; cat "$log" >&2; exit 1; }
+  if ! "$refray" render "$scene" --camera "$camera" --time "$time" --size "$size" --threads "$threads" "${extra[@]}" \
+       -o "$image" > "$log" 2>&1; then
+    echo "lavapipe_speed: $device failed on $name:" >&2; cat "$log" >&2; exit 1
+  fi
   end=$(date +%s.%N)
-  trace=$(sed -n 's/^render: [0-9]*x[0-9]* in \([0-9.]*\) s.*/\1/p' "$log" | head -1)
-  [ -n "$trace" ] || { echo "lavapipe_speed: no trace time in the output of $device on $name:" >&2; cat "$log" >&2; exit 1; }
-  echo "$trace $(awk -v a="$start" -v b="$end" 'BEGIN {printf "%.3f", b - a}')"
+  trace=$(python3 tools/gpu_crosscheck.py metadata "$image" | python3 -c 'import json,sys; print(json.load(sys.stdin)["render_seconds"])')
+  process=$(awk -v a="$start" -v b="$end" 'BEGIN {printf "%.3f", b - a}')
 }
 median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2}'; }
 
-device_line=$("$refray" devices | grep llvmpipe | head -1 | awk '{$1=$1; print}')
+device_line=$("$refray" devices --json | python3 -c '
+import json, sys
+for d in json.load(sys.stdin)["devices"]:
+    if "llvmpipe" in d["driver"]:
+        print(d["name"] + ", " + d["driverInfo"])')
 {
   echo "### refray against Mesa's lavapipe ($size, $threads threads, median of $repeats alternating runs)"
   echo
   echo "lavapipe is a CPU Vulkan driver, not a GPU: \`$device_line\`. Trace: refray's DispatchRays (wall time) and"
   echo "lavapipe's vkCmdTraceRaysKHR (its timestamps); process: the whole \`refray render\` command."
-  echo "Measured $(date -u +%Y-%m-%d) on $(nproc) cores ($(sed -n 's/^model name\s*: //p' /proc/cpuinfo | head -1)),"
+  echo "Measured $(date -u +%Y-%m-%d) on $(nproc) cores ($(grep -m1 '^model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'), load average $(cut -d' ' -f1-3 /proc/loadavg) at the start),"
   echo "refray $("$refray" --version | awk '{print $NF}'), by \`bash tools/lavapipe_speed.sh\`."
   echo
   echo "| setting | refray trace | lavapipe trace | refray / lavapipe | refray process | lavapipe process | refray / lavapipe |"
@@ -77,10 +83,10 @@ for line in "${settings[@]}"; do
   read -r name scene camera time <<< "$line"
   cpu_trace=() cpu_process=() lvp_trace=() lvp_process=()
   for r in $(seq "$repeats"); do
-    read -r t p <<< "$(run_once cpu "$name" "$scene" "$camera" "$time")"
-    cpu_trace+=("$t"); cpu_process+=("$p")
-    read -r t p <<< "$(run_once lavapipe "$name" "$scene" "$camera" "$time")"
-    lvp_trace+=("$t"); lvp_process+=("$p")
+    run_once cpu "$name" "$scene" "$camera" "$time"
+    cpu_trace+=("$trace"); cpu_process+=("$process")
+    run_once lavapipe "$name" "$scene" "$camera" "$time"
+    lvp_trace+=("$trace"); lvp_process+=("$process")
     echo "  $name run $r: refray ${cpu_trace[-1]} s (process ${cpu_process[-1]} s), lavapipe ${lvp_trace[-1]} s (process ${lvp_process[-1]} s)" >&2
   done
   ct=$(printf '%s\n' "${cpu_trace[@]}" | median); cp=$(printf '%s\n' "${cpu_process[@]}" | median)

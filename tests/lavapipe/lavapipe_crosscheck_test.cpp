@@ -25,17 +25,11 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::onLavapipe;
+using testing::shellPath;
 using testing::runRefray;
 const fs::path kRoot = REFRAY_SOURCE_DIR;
 const fs::path kGoldens = kRoot / "tests/golden";
 
-// Built by appending: GCC 12 at -O3 warns (-Wrestrict, a false positive) on "'" + p.string() + "'".
-std::string quoted(const fs::path& p) {
-    std::string q = "'";
-    q += p.string();
-    q += '\'';
-    return q;
-}
 
 std::vector<GoldenEntry> goldens() { return readGoldenManifest(kGoldens / "goldens.json").entries; }
 
@@ -53,7 +47,9 @@ std::string goldenSettingArguments(const GoldenEntry& g) {
 }
 
 // The scene file and its arguments.
-std::string goldenArguments(const GoldenEntry& g) { return quoted(kRoot / g.scene) + goldenSettingArguments(g); }
+std::string goldenArguments(const GoldenEntry& g) {
+    return shellPath(kRoot / g.scene) + goldenSettingArguments(g);
+}
 
 std::string testName(std::string name) {
     for (char& c : name)
@@ -83,7 +79,7 @@ TEST(LavapipeDevices, ANameThatMatchesNoDeviceIsRefusedWithTheList) {
     REFRAY_REQUIRE_LAVAPIPE();
     const fs::path out = testing::testOutputDirectory("lavapipe") / "none.png";
     const testing::CliRun run = runRefray("render builtin --size 8x8 --device vulkan --vulkan-device no-such-gpu -o " +
-                                          quoted(out));
+                                          shellPath(out));
     EXPECT_EQ(run.status, 2) << run.output;
     EXPECT_TRUE(testing::contains(run.output, "no Vulkan device matches 'no-such-gpu'")) << run.output;
     EXPECT_TRUE(testing::contains(run.output, "llvmpipe")) << "the message lists the devices: " << run.output;
@@ -93,7 +89,7 @@ TEST(LavapipeDevices, ANameThatMatchesNoDeviceIsRefusedWithTheList) {
 TEST(LavapipeDevices, ARenderRecordsDeviceDriverAndMesaVersion) {
     REFRAY_REQUIRE_LAVAPIPE();
     const fs::path out = testing::testOutputDirectory("lavapipe") / "builtin.exr";
-    const testing::CliRun run = runRefray("render builtin --size 32x18" + onLavapipe() + " -o " + quoted(out));
+    const testing::CliRun run = runRefray("render builtin --size 32x18" + onLavapipe() + " -o " + shellPath(out));
     ASSERT_EQ(run.status, 0) << run.output;
     const Image image = readImage(out.string());
     EXPECT_EQ(image.metadata.at("device"), "vulkan");
@@ -113,13 +109,13 @@ TEST_P(LavapipeGoldens, RenderPassesItsEnvelopeGolden) {
     const GoldenEntry& g = goldenNamed(GetParam());
     const fs::path dir = testing::testOutputDirectory("lavapipe");
     const fs::path out = dir / (g.name + ".lavapipe.exr"), heat = dir / (g.name + ".heat.png");
-    const testing::CliRun render = runRefray("render " + goldenArguments(g) + onLavapipe() + " -o " + quoted(out));
+    const testing::CliRun render = runRefray("render " + goldenArguments(g) + onLavapipe() + " -o " + shellPath(out));
     ASSERT_EQ(render.status, 0) << render.output;
     const Image image = readImage(out.string());
     EXPECT_NE(image.metadata.at("gpu").find("llvmpipe"), std::string::npos);
     // The user's command: compare --golden finds the envelope in the golden directory by the candidate's name.
-    const testing::CliRun compare = runRefray("compare --golden " + quoted(kGoldens / g.envelope) + " " + quoted(out) +
-                                              " -o " + quoted(heat));
+    const testing::CliRun compare = runRefray("compare --golden " + shellPath(kGoldens / g.envelope) + " " +
+                                              shellPath(out) + " -o " + shellPath(heat));
     std::printf("%s", compare.output.c_str());
     EXPECT_TRUE(compare.status == 0 || compare.status == 1)
         << g.name << ": lavapipe's render fails its envelope golden (exit " << compare.status << "); render "
@@ -220,8 +216,8 @@ TEST_P(LavapipeMaps, EqualRefraysOutsideOrderDependentPixelsAndSilhouettes) {
                               IndexMapKind::Primitive, IndexMapKind::HitGroup}) {
         const std::string kindName = indexMapKindNames()[size_t(kind)];
         const fs::path out = dir / (m.name + "." + kindName + ".exr");
-        const testing::CliRun run = runRefray("render " + quoted(m.scene) + m.arguments + " --aov " + kindName +
-                                              onLavapipe() + " -o " + quoted(out));
+        const testing::CliRun run = runRefray("render " + shellPath(m.scene) + m.arguments + " --aov " + kindName +
+                                              onLavapipe() + " -o " + shellPath(out));
         ASSERT_EQ(run.status, 0) << m.name << " " << kindName << ": " << run.output;
         const Image map = readImage(out.string());
         EXPECT_EQ(map.metadata.at("aov_instance_id_mismatches"), "0")

@@ -20,6 +20,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::onLavapipe;
+using testing::shellPath;
 using testing::runRefray;
 
 const fs::path kRoot = REFRAY_SOURCE_DIR;
@@ -27,13 +28,6 @@ const fs::path kGoldens = kRoot / "tests/golden";
 // The candidate's first seed: the goldens use seed .. seed + batches - 1 (0..15), so 100.. gives other batches.
 constexpr uint32_t kCandidateSeed = 100;
 
-// Built by appending: GCC 12 at -O3 warns (-Wrestrict, a false positive) on "'" + p.string() + "'".
-std::string quoted(const fs::path& p) {
-    std::string q = "'";
-    q += p.string();
-    q += '\'';
-    return q;
-}
 
 StatisticalGoldenEntry statisticalGolden(const std::string& name) {
     for (const StatisticalGoldenEntry& e : readGoldenManifest(kGoldens / "goldens.json").statistical)
@@ -49,9 +43,9 @@ void expectLavapipePassesStatisticalGolden(const std::string& name) {
     fs::remove(out);
     const std::string size = std::to_string(golden.width) + "x" + std::to_string(golden.height);
     const testing::CliRun render =
-        runRefray("render " + quoted(kRoot / golden.scene) + " --camera " + golden.camera + " --size " + size +
+        runRefray("render " + shellPath(kRoot / golden.scene) + " --camera " + golden.camera + " --size " + size +
                   " --spp " + std::to_string(golden.spp) + " --batches " + std::to_string(golden.batches) +
-                  " --seed " + std::to_string(kCandidateSeed) + onLavapipe() + " -o " + quoted(out));
+                  " --seed " + std::to_string(kCandidateSeed) + onLavapipe() + " -o " + shellPath(out));
     ASSERT_EQ(render.status, 0) << render.output;
 
     // The statistics image is lavapipe's: its provenance says so.
@@ -62,7 +56,7 @@ void expectLavapipePassesStatisticalGolden(const std::string& name) {
 
     // The user's command and its exit status: 0 pass, 1 fail.
     const testing::CliRun compare =
-        runRefray("compare --statistical " + quoted(kGoldens / golden.image) + " " + quoted(out));
+        runRefray("compare --statistical " + shellPath(kGoldens / golden.image) + " " + shellPath(out));
     std::printf("%s", compare.output.c_str());
     EXPECT_EQ(compare.status, 0) << golden.name << ": lavapipe's statistics image " << out.string()
                                  << " differs from the golden beyond the noise\n"

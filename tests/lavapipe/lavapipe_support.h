@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 
 #include "core/error.h"
@@ -68,6 +69,15 @@ inline const LavapipeStatus& lavapipeStatus() {
 inline bool runningInCi() {
     const char* ci = std::getenv("CI");
     return ci && std::string(ci) == "true";
+}
+
+// A path for the command line, in single quotes. Built by appending: GCC 12 at -O3 warns (-Wrestrict, a false
+// positive) on "'" + p.string() + "'".
+inline std::string shellPath(const std::filesystem::path& p) {
+    std::string q = "'";
+    q += p.string();
+    q += '\'';
+    return q;
 }
 
 // The refray arguments that render on lavapipe, even where a GPU is the default device.

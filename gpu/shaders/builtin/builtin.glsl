@@ -97,31 +97,8 @@ struct RayDesc {
     float TMax;
 };
 
-// ---- core/ray_offset.h ---------------------------------------------------------------------------
-const float kOffsetOriginBand = 1.0 / 32.0;
-const float kOffsetFloatScale = 1.0 / 65536.0;
-const float kOffsetIntScale = 256.0;
-
-// `p` moved off the surface along `n` (Waechter and Binder, Ray Tracing Gems chapter 6).
-vec3 offsetRayOrigin(vec3 p, vec3 n) {
-    vec3 outp;
-    for (int i = 0; i < 3; ++i) {
-        if (isinf(p[i]) || isnan(p[i]) || isinf(n[i]) || isnan(n[i])) {  // nothing to step
-            outp[i] = p[i];
-            continue;
-        }
-        if (abs(p[i]) < kOffsetOriginBand) {
-            outp[i] = p[i] + kOffsetFloatScale * n[i];
-            continue;
-        }
-        // PORT: std::clamp(v, lo, hi) is v < lo ? lo : hi < v ? hi : v; v is finite here, so GLSL clamp agrees.
-        const float scaled = clamp(kOffsetIntScale * n[i], -2147483520.0, 2147483520.0);
-        const uint ulps = uint(int(scaled));  // truncation toward zero, then the two's-complement bits
-        const uint bits = floatBitsToUint(p[i]);
-        outp[i] = uintBitsToFloat(p[i] < 0.0 ? bits - ulps : bits + ulps);  // uint arithmetic wraps, as in the C++
-    }
-    return outp;
-}
+// ---- core/ray_offset.h: offsetRayOrigin ----------------------------------------------------------------
+#include "common/ray_offset.glsl"
 
 // ---- builtin_shaders.cpp -------------------------------------------------------------------------
 

@@ -166,30 +166,7 @@ bool isFinite(float x) { return !(isnan(x) || isinf(x)); }
 
 bool isZero(vec3 v) { return v.x == 0.0 && v.y == 0.0 && v.z == 0.0; }
 
-// core/ray_offset.h: `p` moved off the surface along `n` (Waechter and Binder, Ray Tracing Gems chapter 6).
-const float kOffsetOriginBand = 1.0 / 32.0;
-const float kOffsetFloatScale = 1.0 / 65536.0;
-const float kOffsetIntScale = 256.0;
-
-vec3 offsetRayOrigin(vec3 p, vec3 n) {
-    vec3 moved;
-    for (int i = 0; i < 3; ++i) {
-        if (!isFinite(p[i]) || !isFinite(n[i])) {
-            moved[i] = p[i];
-            continue;
-        }
-        if (abs(p[i]) < kOffsetOriginBand) {
-            moved[i] = p[i] + kOffsetFloatScale * n[i];
-            continue;
-        }
-        // PORT: std::clamp on a finite value is GLSL clamp; int() truncates toward zero as the C++ cast does, and
-        // uint arithmetic wraps as the C++'s uint32_t does.
-        const float scaled = clamp(kOffsetIntScale * n[i], -2147483520.0, 2147483520.0);
-        const uint ulps = uint(int(scaled));
-        const uint bits = floatBitsToUint(p[i]);
-        moved[i] = uintBitsToFloat(p[i] < 0.0 ? bits - ulps : bits + ulps);
-    }
-    return moved;
-}
+// core/ray_offset.h: offsetRayOrigin.
+#include "common/ray_offset.glsl"
 
 #endif  // PATHTRACER_GLSL
