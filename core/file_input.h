@@ -12,7 +12,7 @@ inline constexpr uint64_t kMaxTextInputBytes = uint64_t(256) << 20;
 // The largest image file refray opens (renders, goldens, envelopes, textures, masks): 2 GiB.
 inline constexpr uint64_t kMaxImageInputBytes = uint64_t(2) << 30;
 // The most pixels an image refray reads may declare in its header, checked before any pixel is allocated: as many as
-// the largest render refray makes (16384 x 16384).
+// the largest render refray makes (16384 x 16384), and at most 4 times as many samples (pixels x channels).
 inline constexpr uint64_t kMaxImagePixels = uint64_t(16384) * 16384;
 
 // Throws refray::Error naming `what` and `path` unless `path` is a regular file of at most `maxBytes`:

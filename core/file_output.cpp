@@ -139,7 +139,8 @@ void writeFileAtomically(const std::string& path, std::string_view bytes) {
     std::error_code error;
     if (fs::is_symlink(fs::symlink_status(target, error))) {
         target = fs::weakly_canonical(target, error);
-        REFRAY_CHECK(!error, "cannot write '" << path << "': cannot resolve the symbolic link: " << reason(error.value()));
+        REFRAY_CHECK(!error, "cannot write '" << path << "': cannot resolve the symbolic link: "
+                                               << reason(error.value()));
         checkOutputPath(target.string());
     }
     const fs::path folder = target.parent_path();
@@ -159,8 +160,9 @@ void writeFileAtomically(const std::string& path, std::string_view bytes) {
         if (open) ::close(fd);
         ::unlink(temporary.c_str());
         unregisterTemporary(slot);
+        std::error_code ignored;
         throw Error("cannot write '" + path + "': " + what + reason(code) + "; " +
-                    (fs::exists(target) ? "the file there is unchanged" : "nothing was written"));
+                    (fs::exists(target, ignored) ? "the file there is unchanged" : "nothing was written"));
     };
 
     // A file replaced keeps its permissions.

@@ -26,7 +26,9 @@ std::unique_ptr<OIIO::ImageInput> openImageFile(const std::string& path, const s
     REFRAY_CHECK(spec.width > 0 && spec.height > 0 && spec.depth > 0 && spec.nchannels > 0,
                  "cannot read " << what << " '" << path << "': it has no pixels");
     const uint64_t pixels = uint64_t(spec.width) * uint64_t(spec.height) * uint64_t(spec.depth);
-    REFRAY_CHECK(pixels <= kMaxImagePixels && spec.nchannels <= 64,
+    // Pixels and samples: a 16384 x 16384 RGBA render is the most refray reads (4 GiB as floats); an image of more
+    // channels (an envelope has 12) may have proportionally fewer pixels.
+    REFRAY_CHECK(pixels <= kMaxImagePixels && pixels * uint64_t(spec.nchannels) <= kMaxImagePixels * 4,
                  "cannot read " << what << " '" << path << "': its header declares " << spec.width << "x"
                                 << spec.height << " pixels (" << spec.nchannels << " channels), more than the "
                                 << kMaxImagePixels << " pixels (16384x16384) refray reads; a file this small ("

@@ -177,7 +177,8 @@ void loadMaterialLibrary(const fs::path& library, MaterialSet& set) {
         if (tokens.empty() || !numeric.count(tokens[0])) continue;
         if (std::find(tokens.begin(), tokens.end(), "spectral") != tokens.end()) continue;  // names a curve file
         for (size_t k = 1; k < tokens.size(); ++k) {
-            const bool option = tokens[k].size() > 1 && tokens[k][0] == '-' && std::isalpha((unsigned char)tokens[k][1]);
+            const bool option =
+                tokens[k].size() > 1 && tokens[k][0] == '-' && std::isalpha((unsigned char)tokens[k][1]);
             if (tokens[k] != "xyz" && !option) checkObjNumber(tokens[k], at(library, i + 1), tokens[0], k);
         }
     }

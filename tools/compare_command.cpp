@@ -553,9 +553,20 @@ int runCompare(const CompareCommandOptions& given) {
     // within the pixel budget before any image's pixels are allocated (exit 4, named).
     try {
         std::vector<NamedPath> inputs{{"REFERENCE", o.reference}, {"CANDIDATE", o.candidate}, {"--mask", o.maskPath}};
-        for (const std::string& dir : {o.goldenSet, o.goldenPath})
-            if (!dir.empty()) inputs.push_back(fs::is_directory(dir) ? NamedPath{"golden manifest", (fs::path(dir) / "goldens.json").string()}
-                                                                     : NamedPath{"--golden", dir});
+        if (!o.reference.empty() && fs::is_regular_file(o.reference))
+            for (const std::string& variant : referenceVariants(o.reference, o.candidate))
+                inputs.push_back({"reference variant", variant});
+        // A golden directory's manifest and envelopes, and the candidates of --golden-set, are inputs too.
+        const auto addFilesOf = [&inputs](const std::string& dir, const std::string& role) {
+            std::error_code error;
+            if (dir.empty() || !fs::is_directory(dir, error)) return;
+            for (const auto& f : fs::directory_iterator(dir, error))
+                if (f.is_regular_file(error)) inputs.push_back({role, f.path().string()});
+        };
+        if (!o.goldenPath.empty()) inputs.push_back({"--golden", o.goldenPath});
+        addFilesOf(o.goldenPath, "golden file");
+        addFilesOf(o.goldenSet, "golden file");
+        if (!o.goldenSet.empty()) addFilesOf(o.candidate, "candidate");
         checkOutputs(inputs, {{"-o", o.diffPath}, {"--html", o.htmlPath}, {"--junit", o.junitPath}, {"--map", o.mapPath}});
     } catch (const Error& e) {
         std::fprintf(stderr, "refray compare: %s\n", e.what());

@@ -135,6 +135,8 @@ int runMake(const GoldenCommandOptions& o) {
 
 int runDiscriminate(const GoldenCommandOptions& o) {
     const auto& d = o.discriminate;
+    checkOutputs({{"golden manifest", (fs::path(d.goldenDirectory) / "goldens.json").string()}},
+                 {{"--markdown", d.markdown}});
     scenes::DiscriminationOptions options;
     options.goldenDirectory = d.goldenDirectory;
     options.repositoryRoot = o.repositoryRoot;

@@ -539,6 +539,15 @@ int main(int argc, char** argv) {
     } catch (const refray::Error& e) {
         std::fprintf(stderr, "refray: %s\n", e.what());
         return 2;
+    } catch (const std::filesystem::filesystem_error& e) {
+        // A folder that cannot be created or removed (a full disk, a file in the way, no permission): the file's
+        // problem, named, not refray's.
+        std::fprintf(stderr, "refray: cannot use '%s': %s\n", e.path1().string().c_str(), e.code().message().c_str());
+        return 2;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "refray: not enough memory for this command (std::bad_alloc); a smaller --size, fewer "
+                             "renders or a machine with more memory may do\n");
+        return 3;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "refray: unexpected error: %s\n", e.what());
         return 3;

@@ -29,7 +29,8 @@ void checkCameraRays(const CameraDesc& c, const procedural::Float4x4& projection
                            << ", after rotateYDegrees) is beyond float's range (+-3.4e38), so the shaders' ray origin "
                               "would be infinite");
     const auto& m = projectionToWorld.m;
-    for (const glm::vec2 screen : {glm::vec2(-1, -1), glm::vec2(1, -1), glm::vec2(-1, 1), glm::vec2(1, 1), glm::vec2(0)}) {
+    const glm::vec2 screens[] = {{-1, -1}, {1, -1}, {-1, 1}, {1, 1}, {0, 0}};
+    for (const glm::vec2 screen : screens) {
         const float in[4] = {screen.x, screen.y, 0.0f, 1.0f};
         float world[4] = {0, 0, 0, 0};
         for (int j = 0; j < 4; ++j)
