@@ -556,12 +556,15 @@ int runCompare(const CompareCommandOptions& given) {
         if (!o.reference.empty() && fs::is_regular_file(o.reference))
             for (const std::string& variant : referenceVariants(o.reference, o.candidate))
                 inputs.push_back({"reference variant", variant});
-        // A golden directory's manifest and envelopes, and the candidates of --golden-set, are inputs too.
+        // A golden directory's manifest and envelopes, and the candidate images of --golden-set, are inputs too.
         const auto addFilesOf = [&inputs](const std::string& dir, const std::string& role) {
             std::error_code error;
             if (dir.empty() || !fs::is_directory(dir, error)) return;
-            for (const auto& f : fs::directory_iterator(dir, error))
-                if (f.is_regular_file(error)) inputs.push_back({role, f.path().string()});
+            for (const auto& f : fs::directory_iterator(dir, error)) {
+                const std::string ext = f.path().extension().string();
+                if (f.is_regular_file(error) && (ext == ".exr" || ext == ".png" || f.path().filename() == "goldens.json"))
+                    inputs.push_back({role, f.path().string()});
+            }
         };
         if (!o.goldenPath.empty()) inputs.push_back({"--golden", o.goldenPath});
         addFilesOf(o.goldenPath, "golden file");
