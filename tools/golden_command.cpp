@@ -217,7 +217,7 @@ CLI::App* addGoldenCommand(CLI::App& app, GoldenCommandOptions& o) {
                                                 "golden directory");
     make->add_option("scene", m.scene, "Scene file (not with --collect)");
     make->add_option("--camera", m.camera, "Camera (default: the scene's first)");
-    make->add_option("--time", m.time, "Time in seconds (default: the scene's)");
+    make->add_option("--time", m.time, "Time in seconds (default: the scene's)")->check(seconds());
     make->add_option("--size", m.size, "WIDTHxHEIGHT")->capture_default_str();
     make->add_option("-o,--dir", m.dir, "The golden directory (goldens.json is created or extended)")->required();
     make->add_option("--root", o.repositoryRoot, "The repository root: scene paths in the manifest are relative to it")
