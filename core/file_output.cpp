@@ -190,8 +190,12 @@ void writeFileAtomically(const std::string& path, std::string_view bytes) {
 
 void removeTemporaryFilesOnSignal() {
     for (const int signal : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {
+        // SIGHUP and SIGQUIT stay ignored where a parent ignored them (nohup). SIGINT and SIGTERM are always handled:
+        // a non-interactive shell starts background commands with SIGINT ignored, and 'kill -INT' must still stop
+        // refray without a partial file.
         struct sigaction old {};
-        if (::sigaction(signal, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+        const bool keepIgnored = signal == SIGHUP || signal == SIGQUIT;
+        if (keepIgnored && ::sigaction(signal, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
         struct sigaction action {};
         action.sa_handler = removeTemporariesAndDie;
         sigemptyset(&action.sa_mask);

@@ -21,7 +21,8 @@ void writeFileAtomically(const std::string& path, std::string_view bytes);
 void checkOutputPath(const std::string& path);
 
 // Installs handlers for SIGINT, SIGTERM, SIGHUP and SIGQUIT that remove the temporary files being written and then
-// end the process by the same signal (so its status still says which); signals that were ignored stay ignored.
+// end the process by the same signal (so its status still says which). SIGHUP and SIGQUIT stay ignored where they
+// were (nohup); SIGINT and SIGTERM are handled even where a shell started refray with them ignored.
 // Also ignores SIGXFSZ, so that a file-size limit fails the write ("file too large") instead of killing the process
 // mid-file. Called once by the command line at start.
 void removeTemporaryFilesOnSignal();

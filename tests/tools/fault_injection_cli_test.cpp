@@ -88,6 +88,16 @@ TEST(FaultInjection, ASignalDuringAWriteLeavesTheOldImageAndNoTemporaryFile) {
     EXPECT_TRUE(contains(r.output, "status=143")) << "killed by SIGTERM: 128 + 15\n" << r.output;
     EXPECT_EQ(fileText(out), before) << "the old image was replaced";
     EXPECT_EQ(leftoverTemporaries(dir), "");
+
+    // SIGINT too, although the shell starts a background command with SIGINT ignored.
+    const std::string interrupt = "REFRAY_TEST_WRITE_DELAY_MS=20000 " + kRefray + " render builtin --size 64x36 -o " +
+                                  out.string() + " & p=$!; i=0; while [ $i -lt 400 ] && ! ls -a " + dir.string() +
+                                  " | grep -q refray-; do sleep 0.05; i=$((i+1)); done; kill -INT $p; wait $p; "
+                                  "echo \"status=$?\"";
+    const auto i = runCommand("sh -c '" + interrupt + "'");
+    EXPECT_TRUE(contains(i.output, "status=130")) << "killed by SIGINT: 128 + 2\n" << i.output;
+    EXPECT_EQ(fileText(out), before) << "the old image was replaced";
+    EXPECT_EQ(leftoverTemporaries(dir), "");
 }
 
 TEST(FaultInjection, AnOutputThatIsAnInputIsRefusedAndTheInputKept) {
