@@ -10,6 +10,7 @@
 #include <boost/math/distributions/binomial.hpp>
 
 #include "core/error.h"
+#include "core/image_file.h"
 
 namespace refray {
 
@@ -132,8 +133,6 @@ void writeEnvelope(const std::string& path, const Envelope& e) {
                      e.orderDependent.size() == n,
                  "cannot write the envelope '" << path << "': its planes do not match its " << sizeText(e.width(), e.height())
                                                << " nominal");
-    auto out = OIIO::ImageOutput::create(path);
-    REFRAY_CHECK(out, "cannot write '" << path << "': " << OIIO::geterror());
     const int channels = int(kChannelNames.size());
     OIIO::ImageSpec spec(int(e.width()), int(e.height()), channels, OIIO::TypeDesc::FLOAT);
     spec.channelnames = kChannelNames;
@@ -149,7 +148,6 @@ void writeEnvelope(const std::string& path, const Envelope& e) {
         spec.attribute(std::string(kMetadataPrefix) + kSensitiveOutsideKey, countList(e.sensitiveOutsideLeaveOneOut));
     spec.attribute("compression", "zip");
     spec.attribute("oiio:UnassociatedAlpha", 1);
-    REFRAY_CHECK(out->open(path, spec), "cannot open '" << path << "' for writing: " << out->geterror());
     std::vector<float> data(n * channels);
     for (size_t i = 0; i < n; ++i) {
         float* p = &data[i * channels];
@@ -161,20 +159,15 @@ void writeEnvelope(const std::string& path, const Envelope& e) {
         p[10] = float(uint8_t(e.pixelClass[i]));
         p[11] = float(e.orderDependent[i]);
     }
-    REFRAY_CHECK(out->write_image(OIIO::TypeDesc::FLOAT, data.data()),
-                 "cannot write pixels to '" << path << "': " << out->geterror());
-    REFRAY_CHECK(out->close(), "cannot close '" << path << "': " << out->geterror());
+    writeImageFile(path, spec, OIIO::TypeDesc::FLOAT, data.data());
 }
 
 namespace {
 
 std::unique_ptr<OIIO::ImageInput> openEnvelope(const std::string& path) {
-    REFRAY_CHECK(std::filesystem::exists(path), "cannot read the envelope '" << path << "': no such file");
     OIIO::ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);
-    auto in = OIIO::ImageInput::open(path, &config);
-    REFRAY_CHECK(in, "cannot read the envelope '" << path << "' (corrupted or not an image): " << OIIO::geterror());
-    return in;
+    return openImageFile(path, "the envelope", config);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <openssl/evp.h>
 
 #include "core/error.h"
+#include "core/file_input.h"
 
 namespace refray {
 
@@ -56,10 +57,7 @@ std::string Sha256::hexDigest() {
 std::string sha256Hex(std::string_view bytes) { return Sha256().update(bytes).hexDigest(); }
 
 std::string sha256HexOfFile(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    REFRAY_CHECK(in, "cannot read " << path.string());
-    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    return sha256Hex(bytes);
+    return sha256Hex(readInputFile(path.string(), "file", kMaxImageInputBytes));
 }
 
 }  // namespace refray

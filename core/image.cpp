@@ -7,6 +7,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "core/error.h"
+#include "core/image_file.h"
 
 namespace refray {
 
@@ -36,9 +37,6 @@ uint8_t floatToUnorm8(float value) {
 void writeImage(const std::string& path, const Image& image) {
     REFRAY_CHECK(!image.empty(), "cannot write '" << path << "': the image is empty");
     const std::string ext = lowerExtension(path);
-    auto out = OIIO::ImageOutput::create(path);
-    REFRAY_CHECK(out, "cannot write '" << path << "': no image format for extension '" << ext
-                                       << "' (" << OIIO::geterror() << ")");
     const bool asFloat = ext == ".exr" || ext == ".hdr" || ext == ".tif" || ext == ".tiff";
     OIIO::ImageSpec spec(int(image.width()), int(image.height()), 4,
                          asFloat ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
@@ -47,37 +45,41 @@ void writeImage(const std::string& path, const Image& image) {
     // A render target's alpha is just a fourth channel: store the colour bytes as they are, not divided by alpha
     // (OpenImageIO would otherwise treat our values as premultiplied and un-premultiply them for PNG).
     spec.attribute("oiio:UnassociatedAlpha", 1);
-    REFRAY_CHECK(out->open(path, spec), "cannot open '" << path << "' for writing: " << out->geterror());
-
-    bool ok = false;
     if (asFloat) {
-        ok = out->write_image(OIIO::TypeDesc::FLOAT, image.pixels().data());
+        writeImageFile(path, spec, OIIO::TypeDesc::FLOAT, image.pixels().data());
     } else {
         std::vector<uint8_t> bytes(image.pixels().size() * 4);
         for (size_t i = 0; i < image.pixels().size(); ++i)
             for (int c = 0; c < 4; ++c) bytes[i * 4 + c] = floatToUnorm8(image.pixels()[i][c]);
-        ok = out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
+        writeImageFile(path, spec, OIIO::TypeDesc::UINT8, bytes.data());
     }
-    REFRAY_CHECK(ok, "cannot write pixels to '" << path << "': " << out->geterror());
-    REFRAY_CHECK(out->close(), "cannot close '" << path << "': " << out->geterror());
+}
+
+ImageHeader readImageHeader(const std::string& path) {
+    OIIO::ImageSpec config;
+    auto in = openImageFile(path, "image", config);
+    return {uint32_t(in->spec().width), uint32_t(in->spec().height), uint32_t(in->spec().nchannels)};
 }
 
 Image readImage(const std::string& path) {
-    REFRAY_CHECK(std::filesystem::exists(path), "cannot read image '" << path << "': no such file");
     // Read colour as stored, without premultiplying it by alpha (see writeImage).
     OIIO::ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);
-    auto in = OIIO::ImageInput::open(path, &config);
-    REFRAY_CHECK(in, "cannot read image '" << path << "': " << OIIO::geterror());
+    auto in = openImageFile(path, "image", config);
     const OIIO::ImageSpec& spec = in->spec();
-    REFRAY_CHECK(spec.width > 0 && spec.height > 0 && spec.nchannels > 0,
-                 "cannot read image '" << path << "': it has no pixels");
     const int channels = spec.nchannels;
-    std::vector<float> data(size_t(spec.width) * spec.height * channels);
+    std::vector<float> data;
+    Image image;
+    try {
+        data.resize(size_t(spec.width) * spec.height * channels);
+        image = Image(uint32_t(spec.width), uint32_t(spec.height));
+    } catch (const std::bad_alloc&) {
+        REFRAY_CHECK(false, "cannot read image '" << path << "': not enough memory for its " << spec.width << "x"
+                                                   << spec.height << " pixels");
+    }
     REFRAY_CHECK(in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, data.data()),
                  "cannot read pixels of '" << path << "': " << in->geterror());
 
-    Image image(uint32_t(spec.width), uint32_t(spec.height));
     for (size_t i = 0; i < image.pixels().size(); ++i) {
         const float* p = &data[i * channels];
         vec4 v;

@@ -38,11 +38,19 @@ uint8_t floatToUnorm8(float value);
 
 // Writes by extension: .exr keeps the floats as written (half-free, 32-bit float);
 // .png stores what an R8G8B8A8_UNORM target holds (floatToUnorm8, no sRGB transfer).
-// Throws refray::Error naming the path on failure.
+// The file is written whole or not at all (core/file_output.h). Throws refray::Error naming the path on failure.
 void writeImage(const std::string& path, const Image& image);
 
+// What an image file's header declares, read without its pixels (to check sizes before reading two images).
+struct ImageHeader {
+    uint32_t width = 0, height = 0, channels = 0;
+};
+// Throws refray::Error naming the path, as readImage does for the same file.
+ImageHeader readImageHeader(const std::string& path);
+
 // Reads any format OpenImageIO knows; 8-bit data becomes value/255. Missing channels:
-// RGB gets alpha 1, grey is replicated. Throws refray::Error naming the path.
+// RGB gets alpha 1, grey is replicated. Throws refray::Error naming the path, also for a directory, a
+// device or a header declaring more than kMaxImagePixels (core/file_input.h), before any pixel is allocated.
 Image readImage(const std::string& path);
 
 }  // namespace refray

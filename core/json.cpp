@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "core/error.h"
+#include "core/file_input.h"
 #include "core/strings.h"
 
 namespace refray::json {
@@ -505,20 +506,7 @@ private:
 Value parse(std::string_view text, std::string file) { return detail::Parser(text, std::move(file)).parseDocument(); }
 
 Value parseFile(const std::filesystem::path& path) {
-    struct FileCloser {
-        void operator()(std::FILE* file) const { std::fclose(file); }
-    };
-    const std::string name = path.string();
-    const auto cannotRead = [&name] { return Error("cannot read " + name + ": " + std::generic_category().message(errno)); };
-    errno = 0;
-    std::unique_ptr<std::FILE, FileCloser> file(std::fopen(name.c_str(), "rb"));
-    if (!file) throw cannotRead();
-    std::string text;
-    char buffer[1 << 16];
-    size_t count = 0;
-    while ((count = std::fread(buffer, 1, sizeof buffer, file.get())) > 0) text.append(buffer, count);
-    if (std::ferror(file.get())) throw cannotRead();
-    return parse(text, name);
+    return parse(readInputFile(path.string(), "JSON file"), path.string());
 }
 
 // ---------------------------------------------------------------------------------------

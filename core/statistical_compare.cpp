@@ -13,6 +13,7 @@
 #include <boost/math/special_functions/beta.hpp>
 
 #include "core/error.h"
+#include "core/image_file.h"
 
 namespace refray {
 
@@ -136,8 +137,6 @@ void writeStatisticsImage(const std::string& path, const StatisticsImage& stats)
     REFRAY_CHECK(stats.batches >= 2, "cannot write '" << path << "': " << stats.batches
                                                       << " batch; a statistics image needs at least 2");
 
-    auto out = OIIO::ImageOutput::create(path);
-    REFRAY_CHECK(out, "cannot write '" << path << "': " << OIIO::geterror());
     OIIO::ImageSpec spec(int(stats.width()), int(stats.height()), 7, OIIO::TypeDesc::FLOAT);
     spec.channelnames = {"R", "G", "B", "A", kVarianceChannelNames[0], kVarianceChannelNames[1], kVarianceChannelNames[2]};
     spec.alpha_channel = 3;
@@ -145,27 +144,20 @@ void writeStatisticsImage(const std::string& path, const StatisticsImage& stats)
     spec.attribute(std::string(kMetadataPrefix) + kStatisticsBatchesKey, std::to_string(stats.batches));
     spec.attribute("compression", "zip");
     spec.attribute("oiio:UnassociatedAlpha", 1);
-    REFRAY_CHECK(out->open(path, spec), "cannot open '" << path << "' for writing: " << out->geterror());
 
     std::vector<float> data(stats.mean.pixels().size() * 7);
     for (size_t i = 0; i < stats.mean.pixels().size(); ++i) {
         for (int c = 0; c < 4; ++c) data[i * 7 + c] = stats.mean.pixels()[i][c];
         for (int c = 0; c < 3; ++c) data[i * 7 + 4 + c] = stats.varianceOfMean[i][c];
     }
-    REFRAY_CHECK(out->write_image(OIIO::TypeDesc::FLOAT, data.data()),
-                 "cannot write pixels to '" << path << "': " << out->geterror());
-    REFRAY_CHECK(out->close(), "cannot close '" << path << "': " << out->geterror());
+    writeImageFile(path, spec, OIIO::TypeDesc::FLOAT, data.data());
 }
 
 StatisticsImage readStatisticsImage(const std::string& path) {
-    REFRAY_CHECK(std::filesystem::exists(path), "cannot read statistics image '" << path << "': no such file");
     OIIO::ImageSpec config;
     config.attribute("oiio:UnassociatedAlpha", 1);
-    auto in = OIIO::ImageInput::open(path, &config);
-    REFRAY_CHECK(in, "cannot read statistics image '" << path << "': " << OIIO::geterror());
+    auto in = openImageFile(path, "statistics image", config);
     const OIIO::ImageSpec& spec = in->spec();
-    REFRAY_CHECK(spec.width > 0 && spec.height > 0 && spec.nchannels > 0,
-                 "cannot read statistics image '" << path << "': it has no pixels");
 
     // Channels by name: OpenEXR stores them sorted, not in the order written.
     int colour[4], variance[3];

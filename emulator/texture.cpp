@@ -8,6 +8,7 @@
 #include <mutex>
 #include <vector>
 
+#include "core/file_input.h"
 #include "core/error.h"
 #include "emulator/validation.h"
 
@@ -301,6 +302,7 @@ Texture2D::~Texture2D() = default;
 
 std::shared_ptr<const Texture2D> Texture2D::fromFile(const std::string& path, bool sRGB) {
     REFRAY_CHECK(!path.empty(), "Texture2D::fromFile needs a file name");
+    checkInputFile(path, "texture", kMaxImageInputBytes);
     auto impl = std::make_unique<Impl>();
     impl->owner = textureSystem();
     impl->system = impl->owner->system;
@@ -315,6 +317,11 @@ std::shared_ptr<const Texture2D> Texture2D::fromFile(const std::string& path, bo
     OIIO::ImageSpec spec;
     if (!impl->handle || !system.get_imagespec(impl->handle, nullptr, 0, spec))
         throw Error("texture '" + path + "': cannot open: " + oiioMessage(system));
+    REFRAY_CHECK(uint64_t(spec.width) * uint64_t(spec.height) <= kMaxImagePixels,
+                 "texture '" << path << "': its header declares " << spec.width << "x" << spec.height
+                             << " pixels, more than the " << kMaxImagePixels
+                             << " pixels (16384x16384) refray reads; a file that claims so much is corrupt or a "
+                                "decompression bomb");
     REFRAY_CHECK(spec.depth <= 1, "texture '" << path << "' is a volume image (depth " << spec.depth
                                               << "); a Texture2D needs a 2D image");
     REFRAY_CHECK(spec.x == 0 && spec.y == 0, "texture '" << path << "' has a data window starting at (" << spec.x

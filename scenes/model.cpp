@@ -1,11 +1,13 @@
 #include "scenes/model.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <iterator>
 #include <limits>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string_view>
 #include <unordered_map>
@@ -13,6 +15,7 @@
 #include <tiny_obj_loader.h>
 
 #include "core/error.h"
+#include "core/file_input.h"
 #include "core/random.h"
 
 namespace refray::scenes {
@@ -26,10 +29,7 @@ constexpr const char* kDefaultMaterialName = "(default)";
 // ---- Text lines -------------------------------------------------------------------------------------------------
 
 std::string readWholeFile(const fs::path& path, const char* what) {
-    REFRAY_CHECK(fs::is_regular_file(path), "cannot read " << what << " " << path.string() << ": no such file");
-    std::ifstream in(path, std::ios::binary);
-    REFRAY_CHECK(in, "cannot read " << what << " " << path.string() << ": it cannot be opened");
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    return readInputFile(path.string(), what);
 }
 
 // Lines without their "\n" or "\r\n"; line k of the file is lines[k - 1].
@@ -71,6 +71,30 @@ int leadingInt(std::string_view s) {
 }
 
 std::string at(const fs::path& file, size_t line) { return file.string() + ":" + std::to_string(line) + ": "; }
+
+// A coordinate of a v, vn or vt statement: the whole token a finite number within float's range. tinyobjloader would
+// read "nan", "oops" or "1e39" as some number (0 for a word) and change the geometry without a word.
+void checkObjNumber(std::string_view token, const std::string& where, std::string_view statement, size_t k) {
+    double value = 0.0;
+    const char* begin = token.data() + (token.size() > 1 && token[0] == '+' ? 1 : 0);
+    const char* end = token.data() + token.size();
+    const auto [stop, error] = std::from_chars(begin, end, value);
+    const bool number = error == std::errc() && stop == end;
+    REFRAY_CHECK(number || error == std::errc::result_out_of_range,
+                 where << statement << " statement: value " << k << " is '" << token << "', not a number");
+    REFRAY_CHECK(number && std::isfinite(value) && std::abs(value) <= double(std::numeric_limits<float>::max()),
+                 where << statement << " statement: value " << k << " is '" << token
+                       << "', which is not a finite number within float's range (+-3.4e38)");
+}
+
+// A face corner's index: an optional sign and digits, nothing else.
+int strictIndex(std::string_view token, const std::string& where, const char* what) {
+    const size_t digits = (!token.empty() && (token[0] == '-' || token[0] == '+')) ? 1 : 0;
+    const bool ok = token.size() > digits && std::all_of(token.begin() + digits, token.end(),
+                                                         [](char c) { return c >= '0' && c <= '9'; });
+    REFRAY_CHECK(ok, where << "face refers to " << what << " '" << token << "', which is not a whole number");
+    return leadingInt(token);
+}
 
 // ---- Material libraries -----------------------------------------------------------------------------------------
 
@@ -145,6 +169,19 @@ void loadMaterialLibrary(const fs::path& library, MaterialSet& set) {
     tinyobj::LoadMtl(&ids, &materials, &stream, &warning, &error);
     REFRAY_CHECK(error.empty(), "cannot parse material library " << library.string() << ": " << error);
     const std::vector<std::string_view> lines = splitLines(text);
+    // The numeric statements: tinyobjloader reads "nan" or a word as some number without a word.
+    static const std::set<std::string_view> numeric = {"Ka", "Kd", "Ks", "Ke", "Kt", "Tf", "Ns", "Ni", "d", "Tr",
+                                                       "illum", "Pr", "Pm", "Ps", "Pc", "Pcr", "aniso", "anisor"};
+    for (size_t i = 0; i < lines.size(); ++i) {
+        const std::vector<std::string_view> tokens = splitTokens(lines[i]);
+        if (tokens.empty() || !numeric.count(tokens[0])) continue;
+        if (std::find(tokens.begin(), tokens.end(), "spectral") != tokens.end()) continue;  // names a curve file
+        for (size_t k = 1; k < tokens.size(); ++k) {
+            const bool option =
+                tokens[k].size() > 1 && tokens[k][0] == '-' && std::isalpha((unsigned char)tokens[k][1]);
+            if (tokens[k] != "xyz" && !option) checkObjNumber(tokens[k], at(library, i + 1), tokens[0], k);
+        }
+    }
     for (const tinyobj::material_t& m : materials) {
         if (m.name.empty() || set.ids.count(m.name)) continue;  // a file without newmtl; a name defined before
         set.ids.emplace(m.name, int(set.parsed.size()));
@@ -207,10 +244,13 @@ ObjLines checkObjStatements(const fs::path& path, const std::vector<std::string_
         const std::vector<std::string_view> tokens = splitTokens(lines[i]);
         if (tokens.empty()) continue;
         const std::string where = at(path, i + 1);
-        if (tokens[0] == "v") ++vertices;
-        else if (tokens[0] == "vn") ++normals;
-        else if (tokens[0] == "vt") ++texcoords;
-        else if (tokens[0] == "mtllib") {
+        if (tokens[0] == "v" || tokens[0] == "vn" || tokens[0] == "vt") {
+            const size_t least = tokens[0] == "vt" ? 1 : 3;
+            REFRAY_CHECK(tokens.size() > least, where << tokens[0] << " statement has " << (tokens.size() - 1)
+                                                      << " values; it needs at least " << least);
+            for (size_t k = 1; k < tokens.size(); ++k) checkObjNumber(tokens[k], where, tokens[0], k);
+            ++(tokens[0] == "v" ? vertices : tokens[0] == "vn" ? normals : texcoords);
+        } else if (tokens[0] == "mtllib") {
             for (size_t k = 1; k < tokens.size(); ++k) {
                 const fs::path library = (path.parent_path() / fs::path(tokens[k])).lexically_normal();
                 REFRAY_CHECK(fs::is_regular_file(library), where << "cannot read material library '" << tokens[k]
@@ -237,19 +277,19 @@ ObjLines checkObjStatements(const fs::path& path, const std::vector<std::string_
             for (size_t k = 1; k < tokens.size(); ++k) {
                 const std::string_view corner = tokens[k];
                 const size_t slash1 = corner.find('/');
-                checkFaceIndex(leadingInt(corner.substr(0, slash1)), vertices, out.vertexLines.size(), "vertex",
-                               "vertices", where);
+                checkFaceIndex(strictIndex(corner.substr(0, slash1), where, "vertex"), vertices,
+                               out.vertexLines.size(), "vertex", "vertices", where);
                 if (slash1 == std::string_view::npos) continue;
                 const size_t slash2 = corner.find('/', slash1 + 1);
                 const std::string_view vt = corner.substr(slash1 + 1, slash2 == std::string_view::npos
                                                                           ? std::string_view::npos
                                                                           : slash2 - slash1 - 1);
                 if (!vt.empty() || slash2 == std::string_view::npos)
-                    checkFaceIndex(leadingInt(vt), texcoords, out.texcoordLines.size(), "texcoord", "texcoords",
-                                   where);
+                    checkFaceIndex(strictIndex(vt, where, "texcoord"), texcoords, out.texcoordLines.size(),
+                                   "texcoord", "texcoords", where);
                 if (slash2 != std::string_view::npos)
-                    checkFaceIndex(leadingInt(corner.substr(slash2 + 1)), normals, out.normalLines.size(), "normal",
-                                   "normals", where);
+                    checkFaceIndex(strictIndex(corner.substr(slash2 + 1), where, "normal"), normals,
+                                   out.normalLines.size(), "normal", "normals", where);
             }
         }
     }

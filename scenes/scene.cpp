@@ -4,7 +4,9 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <map>
+#include <set>
 
 #include "core/error.h"
 #include "core/strings.h"
@@ -109,7 +111,16 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
             bufferAddresses_[i] = memory.upload(b.bytes.data(), b.bytes.size(), b.name);
     }
 
-    // One BLAS per bottom-level entry, geometries in file order (GeometryIndex, IDX-4).
+    // One BLAS per bottom-level entry, geometries in file order (GeometryIndex, IDX-4). The device's build warnings
+    // name a geometry and a primitive; each is kept with the scene file position of what it is about.
+    std::set<std::pair<std::string, std::string>> seen;
+    const auto takeWarnings = [&](const std::function<std::string(const dxr::Diagnostic&)>& whereOf) {
+        for (dxr::Diagnostic d : device_.buildDiagnostics().warnings()) {
+            if (!seen.insert({d.ruleId, d.message}).second) continue;
+            d.message = whereOf(d) + d.message;
+            buildWarnings_.push_back(std::move(d));
+        }
+    };
     for (const BlasDesc& blas : desc_.blases) {
         BottomLevelInputs inputs;
         inputs.Flags = blas.buildFlags;
@@ -133,6 +144,9 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
             inputs.GeometryDescs.push_back(d);
         }
         blasAddresses_.push_back(device_.buildBottomLevelAS(inputs));
+        takeWarnings([&blas](const dxr::Diagnostic&) {
+            return json::toString(blas.where) + ": bottom-level '" + blas.name + "': ";
+        });
     }
 
     // The TLAS, instances in file order (InstanceIndex).
@@ -142,6 +156,15 @@ Scene::Scene(SceneDesc desc) : desc_(std::move(desc)) {
             makeInstanceDesc(i.transform, i.instanceID, i.mask, i.contribution, i.flags, blasAddresses_[i.blas]));
     tlas_ = device_.buildTopLevelAS({BUILD_FLAG_PREFER_FAST_TRACE, uint32_t(instances.size()), ElementsLayout::Array,
                                      memory.upload(instances, desc_.name + " instance descs")});
+    takeWarnings([this](const dxr::Diagnostic& d) -> std::string {
+        for (const dxr::DiagnosticValue& v : d.values)
+            if (v.name == "InstanceIndex") {
+                const size_t i = std::stoul(v.value);
+                if (i < desc_.instances.size())
+                    return json::toString(desc_.instances[i].where) + ": instance '" + desc_.instances[i].name + "': ";
+            }
+        return desc_.file.string() + ": ";
+    });
 
     // Root signatures and the descriptor heap for the global tables.
     globalSignature_ = RootSignature::create(desc_.globalSignature);

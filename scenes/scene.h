@@ -21,6 +21,9 @@ public:
     RenderResult render(const RenderSettings& settings);
 
     const SceneDesc& desc() const { return desc_; }
+    // The warnings building the acceleration structures gave (DEGEN-8 inverted AABBs, INST-9 singular instance
+    // transforms, ...), once each, every message starting with the scene file position of what it is about.
+    const std::vector<dxr::Diagnostic>& buildWarnings() const { return buildWarnings_; }
     dxr::Device& device() { return device_; }
     dxr::GpuVirtualAddress tlas() const { return tlas_; }
     // The GPU address of BLAS `index` (SceneDesc::blases order).
@@ -52,6 +55,7 @@ private:
 
     SceneDesc desc_;
     dxr::Device device_;
+    std::vector<dxr::Diagnostic> buildWarnings_;
     std::vector<dxr::GpuVirtualAddress> bufferAddresses_;  // data buffers (0 for generated ones)
     std::vector<dxr::GpuVirtualAddress> blasAddresses_;
     dxr::GpuVirtualAddress tlas_ = 0;

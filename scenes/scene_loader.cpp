@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "core/file_input.h"
 #include "core/error.h"
 #include "core/hash.h"
 #include "core/strings.h"
@@ -129,10 +130,7 @@ SceneDesc parseScene(std::string_view text, const std::string& fileName) {
 }
 
 SceneDesc loadSceneFile(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    REFRAY_CHECK(in, "cannot read scene file " << path.string() << ": " << std::strerror(errno));
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    return parseScene(text, path.string());
+    return parseScene(readInputFile(path.string(), "scene file"), path.string());
 }
 
 }  // namespace refray::scenes

@@ -11,7 +11,12 @@
 #include <fstream>
 #include <sstream>
 #include <string_view>
+#include <thread>
+#include <sched.h>
 #include <unistd.h>
+
+#include "core/file_input.h"
+#include "core/file_output.h"
 
 #include "core/error.h"
 #include "core/strings.h"
@@ -123,7 +128,21 @@ CLI::Validator oneOf(const std::vector<std::string>& names) {
         "");
 }
 
-CLI::Validator threadCount() { return wholeNumber("a number of worker threads (0: all)"); }
+uint32_t maxThreads() {
+    // The processors this process may run on (oneTBB's own limit), not every processor of the machine.
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0) return uint32_t(CPU_COUNT(&set));
+    return std::max(1u, std::thread::hardware_concurrency());
+}
+
+uint32_t threadsRun(uint32_t requested) { return requested == 0 ? maxThreads() : std::min(requested, maxThreads()); }
+
+CLI::Validator threadCount() {
+    return wholeNumber("a number of worker threads from 0 (all) to " + std::to_string(maxThreads()) +
+                           " (the hardware threads of this machine)",
+                       0, maxThreads());
+}
 
 CLI::Validator seconds() {
     return number("a time in seconds", [](double t) { return std::isfinite(t); });
@@ -169,10 +188,44 @@ Progress::Sink terminalProgress() {
     };
 }
 
-void writeOutput(const std::string& path, const Image& image) {
-    const auto parent = std::filesystem::path(path).parent_path();
-    if (!parent.empty()) std::filesystem::create_directories(parent);
-    writeImage(path, image);
+void writeOutput(const std::string& path, const Image& image) { writeImage(path, image); }
+
+namespace {
+
+// Whether two paths name one file: the same existing file, or (not yet existing) the same absolute path.
+bool samePath(const std::string& a, const std::string& b) {
+    if (sameFile(a, b)) return true;
+    std::error_code error;
+    const auto ca = std::filesystem::weakly_canonical(a, error);
+    if (error) return false;
+    const auto cb = std::filesystem::weakly_canonical(b, error);
+    return !error && ca == cb;
+}
+
+}  // namespace
+
+void checkOutputs(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs) {
+    for (size_t i = 0; i < outputs.size(); ++i) {
+        const NamedPath& out = outputs[i];
+        if (out.path.empty()) continue;
+        for (const NamedPath& in : inputs)
+            REFRAY_CHECK(in.path.empty() || !samePath(out.path, in.path),
+                         "the output " << out.role << " '" << out.path << "' is the input " << in.role << " '"
+                                       << in.path << "'; refray never overwrites an input: give another output file");
+        for (size_t j = 0; j < i; ++j)
+            REFRAY_CHECK(outputs[j].path.empty() || !samePath(out.path, outputs[j].path),
+                         "the outputs " << outputs[j].role << " '" << outputs[j].path << "' and " << out.role << " '"
+                                        << out.path << "' are the same file; give each its own name");
+        checkOutputPath(out.path);
+    }
+}
+
+void reportBuildWarnings(const std::string& command, const std::vector<dxr::Diagnostic>& warnings, bool asErrors) {
+    for (const dxr::Diagnostic& w : warnings) std::fprintf(stderr, "refray %s: %s\n", command.c_str(), w.format().c_str());
+    REFRAY_CHECK(!asErrors || warnings.empty(), "--warnings-as-errors: the scene has " << warnings.size()
+                                                                                       << " build warning"
+                                                                                       << (warnings.size() == 1 ? "" : "s")
+                                                                                       << " (above)");
 }
 
 namespace {

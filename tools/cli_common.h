@@ -12,6 +12,7 @@
 #include "core/image.h"
 #include "core/progress.h"
 #include "core/text_file.h"  // writeTextFile, which the commands use
+#include "emulator/validation.h"
 
 namespace refray::tools {
 
@@ -41,6 +42,30 @@ CLI::Validator seconds();
 // other error (an unknown option, a value an option does not accept, a missing or an extra argument) prints
 // "refray SUBCOMMAND: what is wrong (see 'refray SUBCOMMAND --help')" to stderr and gives 2, bad input's status.
 int parseErrorStatus(const CLI::App& app, const CLI::ParseError& error);
+
+// A file a command reads or writes, with how the user named it: {"-o", "out.png"}, {"the scene file", "a.json"}.
+struct NamedPath {
+    std::string role;
+    std::string path;
+};
+
+// Before any work: refuses (refray::Error, exit 2) an output that is one of the inputs or another output (through
+// links, "..", hard links), naming both, and an output that cannot become a file (core/file_output.h's
+// checkOutputPath: a file where its folder should be, a directory or device in its place). Empty paths are skipped.
+void checkOutputs(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs);
+
+// Prints a scene's build warnings (scenes::Scene::buildWarnings: rule id, scene file:line) to stderr, once each, as
+// "refray COMMAND: warning DEGEN-8: ..."; with `asErrors` (--warnings-as-errors) then throws refray::Error (exit 2).
+void reportBuildWarnings(const std::string& command, const std::vector<dxr::Diagnostic>& warnings, bool asErrors);
+// The option every command that builds a scene takes.
+inline constexpr const char* kWarningsAsErrorsHelp =
+    "Treat the scene's build warnings (inverted AABBs, singular instance transforms, ...) as errors: exit 2";
+
+// The largest --threads a command takes: the hardware threads of this machine (more cannot run at once, and the
+// metadata would record threads that never ran).
+uint32_t maxThreads();
+// What --threads 0 ("all") or N really runs.
+uint32_t threadsRun(uint32_t requested);
 
 // A progress bar on stderr when it is a terminal; an empty sink otherwise.
 Progress::Sink terminalProgress();

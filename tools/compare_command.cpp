@@ -449,10 +449,14 @@ int runGoldenSet(const CompareCommandOptions& o) {
         const auto start = std::chrono::steady_clock::now();
         r.name = e.name;
         r.envelopePath = (directory / e.envelope).string();
+        std::vector<std::string> found;
         for (const char* ext : {".exr", ".png"})
-            if (r.candidatePath.empty() && fs::exists(fs::path(o.candidate) / (e.name + ext)))
-                r.candidatePath = (fs::path(o.candidate) / (e.name + ext)).string();
+            if (fs::exists(fs::path(o.candidate) / (e.name + ext))) found.push_back((fs::path(o.candidate) / (e.name + ext)).string());
+        if (!found.empty()) r.candidatePath = found.front();
         try {
+            // Two candidates for one golden: judging either would be a quiet choice.
+            REFRAY_CHECK(found.size() < 2, "two candidates, " << found[0] << " and " << found[1]
+                                                               << "; keep the one to judge");
             checkSceneUnchanged(e, directory);
             r.envelope = readEnvelope(r.envelopePath);
             if (r.candidatePath.empty()) {
@@ -531,12 +535,7 @@ int runGoldenSet(const CompareCommandOptions& o) {
                 xml << "    </testcase>\n";
             }
             xml << "  </testsuite>\n</testsuites>\n";
-            createParentDirectory(o.junitPath);
-            std::ofstream out(o.junitPath, std::ios::binary);
-            REFRAY_CHECK(out, "cannot write the JUnit report '" << o.junitPath << "'");
-            out << xml.str();
-            out.close();
-            REFRAY_CHECK(out, "cannot write the JUnit report '" << o.junitPath << "'");
+            writeTextFile(o.junitPath, xml.str());
             std::printf("wrote %s\n", o.junitPath.c_str());
         }
     } catch (const Error& e) {
@@ -550,6 +549,41 @@ int runGoldenSet(const CompareCommandOptions& o) {
 
 int runCompare(const CompareCommandOptions& given) {
     CompareCommandOptions o = given;
+    // Before any work: no output may be an input or another output (exit 2, both named), and every image header is
+    // within the pixel budget before any image's pixels are allocated (exit 4, named).
+    try {
+        std::vector<NamedPath> inputs{{"REFERENCE", o.reference}, {"CANDIDATE", o.candidate}, {"--mask", o.maskPath}};
+        if (!o.reference.empty() && fs::is_regular_file(o.reference))
+            for (const std::string& variant : referenceVariants(o.reference, o.candidate))
+                inputs.push_back({"reference variant", variant});
+        // A golden directory's manifest and envelopes, and the candidate images of --golden-set, are inputs too.
+        const auto addFilesOf = [&inputs](const std::string& dir, const std::string& role) {
+            std::error_code error;
+            if (dir.empty() || !fs::is_directory(dir, error)) return;
+            for (const auto& f : fs::directory_iterator(dir, error)) {
+                const std::string ext = f.path().extension().string();
+                if (f.is_regular_file(error) && (ext == ".exr" || ext == ".png" || f.path().filename() == "goldens.json"))
+                    inputs.push_back({role, f.path().string()});
+            }
+        };
+        if (!o.goldenPath.empty()) inputs.push_back({"--golden", o.goldenPath});
+        addFilesOf(o.goldenPath, "golden file");
+        addFilesOf(o.goldenSet, "golden file");
+        if (!o.goldenSet.empty()) addFilesOf(o.candidate, "candidate");
+        checkOutputs(inputs, {{"-o", o.diffPath}, {"--html", o.htmlPath}, {"--junit", o.junitPath}, {"--map", o.mapPath}});
+    } catch (const Error& e) {
+        std::fprintf(stderr, "refray compare: %s\n", e.what());
+        return 2;
+    }
+    if (o.goldenSet.empty() && !o.statistical) {
+        try {
+            for (const std::string& path : {o.reference, o.candidate, o.maskPath})
+                if (!path.empty()) readImageHeader(path);
+        } catch (const Error& e) {
+            std::fprintf(stderr, "refray compare: %s\n", e.what());
+            return 4;
+        }
+    }
     if (!o.goldenSet.empty()) return runGoldenSet(o);
     if (!o.goldenPath.empty()) {
         bool envelope = fs::is_directory(o.goldenPath);
@@ -566,6 +600,25 @@ int runCompare(const CompareCommandOptions& given) {
     }
     if (o.statistical) return runStatisticalCompare(o);
     try {
+        // Sizes from the headers first: a candidate of another size than its one reference is a mismatch before any
+        // pixel is allocated (the HTML report, which shows the images, reads them anyway).
+        if (o.htmlPath.empty()) {
+            try {
+                const std::vector<std::string> variants = referenceVariants(o.reference, o.candidate);
+                const ImageHeader c = readImageHeader(o.candidate), r = readImageHeader(variants.front());
+                if (variants.size() == 1 && (c.width != r.width || c.height != r.height)) {
+                    std::printf("Comparing \"%s\" against \"%s\"\n  size mismatch: reference is %ux%u, candidate is "
+                                "%ux%u\n  verdict         MISMATCH\n",
+                                o.candidate.c_str(), variants.front().c_str(), r.width, r.height, c.width, c.height);
+                    if (!o.diffPath.empty())
+                        std::fprintf(stderr, "refray compare: no diff image written: size mismatch\n");
+                    return int(CompareVerdict::Mismatch);
+                }
+            } catch (const Error& e) {
+                std::fprintf(stderr, "refray compare: %s\n", e.what());
+                return 4;
+            }
+        }
         // Inputs: any unreadable file is exit 4, named.
         Image candidate, mask;
         if (!readInto(o.candidate, candidate)) return 4;
@@ -700,11 +753,7 @@ void writeCompareReport(const std::string& path, CompareVerdict overall, const s
     }
     html << "</tbody>\n</table>\n<script>" << kScript << "</script>\n</body>\n</html>\n";
 
-    std::ofstream out(path, std::ios::binary);
-    REFRAY_CHECK(out, "cannot write the HTML report '" << path << "'");
-    out << html.str();
-    out.close();
-    REFRAY_CHECK(out, "cannot write the HTML report '" << path << "'");
+    writeTextFile(path, html.str());
 }
 
 }  // namespace refray::tools

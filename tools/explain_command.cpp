@@ -26,6 +26,7 @@ CLI::App* addExplainCommand(CLI::App& app, ExplainCommandOptions& o) {
     c->add_option("--order", o.order, "Traversal order: ordered (default) or adversarial (GEN-3)");
     c->add_option("--seed", o.seed, "Seed of the adversarial order")
         ->check(wholeNumber("a seed from 0 to 18446744073709551615", 0, std::numeric_limits<uint64_t>::max()));
+    c->add_flag("--warnings-as-errors", o.warningsAsErrors, kWarningsAsErrorsHelp);
     c->add_flag("--json", o.json, "Write JSON (format refray-explain/1) instead of text");
     c->add_option("-o,--output", o.output, "Write to this file instead of stdout");
     c->add_option("--html", o.html,
@@ -133,8 +134,14 @@ const m=/pixel=(\d+),(\d+)/.exec(location.hash);
 
 int runExplain(const ExplainCommandOptions& o) {
     REFRAY_CHECK(!o.pixel.empty() || !o.html.empty(), "refray explain needs --pixel X,Y (or --html PAGE for every pixel)");
+    const std::vector<NamedPath> outputs{{"-o", o.output}, {"--html", o.html}};
+    checkOutputs({{"scene file", o.scene}}, outputs);
     std::unique_ptr<scenes::Scene> scene = scenes::loadScene(o.scene);
     const scenes::SceneDesc& desc = scene->desc();
+    std::vector<NamedPath> inputs{{"scene file", o.scene}};
+    for (const scenes::ModelDesc& m : desc.models) inputs.push_back({"model file", m.file.string()});
+    checkOutputs(inputs, outputs);
+    reportBuildWarnings("explain", scene->buildWarnings(), o.warningsAsErrors);
     const Size size = !o.size.empty() ? parseSize(o.size)
                       : o.html.empty() ? Size{desc.defaultWidth, desc.defaultHeight}
                                        : Size{std::max(1u, desc.defaultWidth / 4), std::max(1u, desc.defaultHeight / 4)};

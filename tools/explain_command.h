@@ -19,6 +19,7 @@ struct ExplainCommandOptions {
     std::string order = "ordered";
     uint64_t seed = 0;
     bool json = false;
+    bool warningsAsErrors = false;  // --warnings-as-errors
     std::string output;  // empty: stdout
     std::string html;    // write the interactive page here (every pixel; --pixel then only preselects one)
 };

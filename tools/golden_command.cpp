@@ -18,6 +18,13 @@ static_assert(GoldenCommandOptions{}.update.perturbed == scenes::kDefaultPerturb
 
 namespace {
 
+// Fewer perturbed renders calibrate nothing: K = 3 is the least that draws each contraction mode (mixed, split, fuse)
+// and both denormal modes once (scenes::goldenPerturbation) and leaves two others for each leave-one-out count.
+constexpr uint32_t kMinPerturbedRenders = 3;
+constexpr const char* kPerturbedAccepts =
+    "a number of perturbed renders from 3 to 1000 (fewer cannot calibrate an envelope: each contraction and denormal "
+    "mode needs a render, and the leave-one-out counts need two others)";
+
 void printRender(const std::string& what, double seconds) {
     std::printf("    %-28s %7.2f s\n", what.c_str(), seconds);
     std::fflush(stdout);
@@ -40,6 +47,12 @@ int emitJobs(const GoldenCommandOptions& o, const std::string& file, const std::
                 "array: README), then: %s\n",
                 lines.size(), file.c_str(), dir.c_str(), file.c_str(), collect.c_str());
     return 0;
+}
+
+// Shows each scene's build warnings once, as render does; --warnings-as-errors stops at them.
+scenes::SceneBuiltCallback sceneWarnings(const GoldenCommandOptions& o, const std::string& command) {
+    const bool asErrors = o.warningsAsErrors;
+    return [asErrors, command](const scenes::Scene& scene) { reportBuildWarnings(command, scene.buildWarnings(), asErrors); };
 }
 
 int runUpdate(const GoldenCommandOptions& o) {
@@ -67,11 +80,13 @@ int runUpdate(const GoldenCommandOptions& o) {
                     (unsigned long long)e.orderDependentPixels);
         std::fflush(stdout);
     };
+    options.onSceneBuilt = sceneWarnings(o, "golden update");
     options.onStatisticalEntry = [](const scenes::StatisticalGoldenEntry& e, double seconds) {
         std::printf("%-48s %ux%u  %6.2f s  statistical: %u batches of %u spp\n", e.name.c_str(), e.width, e.height,
                     seconds, e.batches, e.spp);
         std::fflush(stdout);
     };
+    checkOutputs({}, {{"--emit-jobs", u.emitJobs}, {"goldens.json (in --dir)", (fs::path(u.dir) / "goldens.json").string()}});
     if (!u.emitJobs.empty()) {
         scenes::writeGoldenPlan(u.dir, scenes::planUpdate(options), true);
         return emitJobs(o, u.emitJobs, u.dir, "refray golden update --collect --dir " + u.dir);
@@ -105,6 +120,8 @@ int runMake(const GoldenCommandOptions& o) {
     options.refrayCommit = kCommit;
     options.render.threads = m.threads;
     options.render.onRender = printRender;
+    options.onSceneBuilt = sceneWarnings(o, "golden make");
+    checkOutputs({{"scene file", m.scene}}, {{"--emit-jobs", m.emitJobs}, {"goldens.json (in -o)", (fs::path(m.dir) / "goldens.json").string()}});
     if (!m.emitJobs.empty()) {
         scenes::writeGoldenPlan(m.dir, {scenes::planMake(options)}, false);
         return emitJobs(o, m.emitJobs, m.dir, "refray golden make --collect -o " + m.dir);
@@ -118,6 +135,8 @@ int runMake(const GoldenCommandOptions& o) {
 
 int runDiscriminate(const GoldenCommandOptions& o) {
     const auto& d = o.discriminate;
+    checkOutputs({{"golden manifest", (fs::path(d.goldenDirectory) / "goldens.json").string()}},
+                 {{"--markdown", d.markdown}});
     scenes::DiscriminationOptions options;
     options.goldenDirectory = d.goldenDirectory;
     options.repositoryRoot = o.repositoryRoot;
@@ -176,8 +195,9 @@ CLI::App* addGoldenCommand(CLI::App& app, GoldenCommandOptions& o) {
     auto& u = o.update;
     auto* update = golden->add_subcommand("update", "Re-render the envelope golden of every scene x camera and the "
                                                     "manifest (docs/golden-format.md)");
+    update->add_flag("--warnings-as-errors", o.warningsAsErrors, kWarningsAsErrorsHelp);
     update->add_option("--perturbed", u.perturbed, "Perturbed renders per golden (K: seeds 1..K)")
-        ->check(wholeNumber("a number of perturbed renders"))
+        ->check(wholeNumber(kPerturbedAccepts, kMinPerturbedRenders, 1000))
         ->capture_default_str();
     update->add_option("--dir", u.dir, "Where the goldens go")->capture_default_str();
     update->add_option("--root", o.repositoryRoot, "The repository root (holds scenes/)")->capture_default_str();
@@ -197,7 +217,7 @@ CLI::App* addGoldenCommand(CLI::App& app, GoldenCommandOptions& o) {
                                                 "golden directory");
     make->add_option("scene", m.scene, "Scene file (not with --collect)");
     make->add_option("--camera", m.camera, "Camera (default: the scene's first)");
-    make->add_option("--time", m.time, "Time in seconds (default: the scene's)");
+    make->add_option("--time", m.time, "Time in seconds (default: the scene's)")->check(seconds());
     make->add_option("--size", m.size, "WIDTHxHEIGHT")->capture_default_str();
     make->add_option("-o,--dir", m.dir, "The golden directory (goldens.json is created or extended)")->required();
     make->add_option("--root", o.repositoryRoot, "The repository root: scene paths in the manifest are relative to it")
@@ -205,8 +225,9 @@ CLI::App* addGoldenCommand(CLI::App& app, GoldenCommandOptions& o) {
     make->add_option("--order-check", m.orders, "Adversarial orders")
         ->check(wholeNumber("a number of adversarial orders"))
         ->capture_default_str();
+    make->add_flag("--warnings-as-errors", o.warningsAsErrors, kWarningsAsErrorsHelp);
     make->add_option("--perturbed", m.perturbed, "Perturbed renders (K: seeds 1..K)")
-        ->check(wholeNumber("a number of perturbed renders"))
+        ->check(wholeNumber(kPerturbedAccepts, kMinPerturbedRenders, 1000))
         ->capture_default_str();
     make->add_option("--threads", m.threads, "Worker threads (0: all)")->check(threadCount());
     make->add_option("--emit-jobs", m.emitJobs,
@@ -222,6 +243,7 @@ CLI::App* addGoldenCommand(CLI::App& app, GoldenCommandOptions& o) {
     job->add_option("--root", o.repositoryRoot, "The repository root: the plan's scene paths are relative to it")
         ->capture_default_str();
     job->add_option("--threads", j.threads, "Worker threads (0: all)")->check(threadCount());
+    job->add_flag("--warnings-as-errors", o.warningsAsErrors, kWarningsAsErrorsHelp);
     o.jobCommand = job;
 
     auto& d = o.discriminate;
@@ -245,7 +267,8 @@ CLI::App* addGoldenCommand(CLI::App& app, GoldenCommandOptions& o) {
 
 int runGolden(const GoldenCommandOptions& o) {
     if (*o.jobCommand) {
-        scenes::runGoldenJob(o.job.dir, o.repositoryRoot, o.job.name, o.job.part, o.job.threads);
+        scenes::runGoldenJob(o.job.dir, o.repositoryRoot, o.job.name, o.job.part, o.job.threads,
+                             sceneWarnings(o, "golden job"));
         return 0;
     }
     if (*o.updateCommand) return runUpdate(o);

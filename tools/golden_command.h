@@ -22,6 +22,7 @@ namespace refray::tools {
 
 struct GoldenCommandOptions {
     std::string repositoryRoot = ".";
+    bool warningsAsErrors = false;  // --warnings-as-errors (update, make, job)
     struct {
         std::string dir = "tests/golden", size = "320x180", emitJobs;
         uint32_t orders = 4, threads = 0, perturbed = 8;

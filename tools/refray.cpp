@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 
 #include "core/error.h"
+#include "core/file_output.h"
 #include "core/image.h"
 #include "core/json_writer.h"
 #include "core/statistical_compare.h"
@@ -188,6 +189,7 @@ struct RenderOptions {
     std::string device = "cpu";      // --device: where DispatchRays runs (tools/render_device.h)
     std::string spirvDir;            // --spirv-dir
     std::string vulkanDevice;        // --vulkan-device
+    bool warningsAsErrors = false;   // --warnings-as-errors
 };
 
 bool endsWithExr(const std::string& path) {
@@ -266,7 +268,24 @@ std::optional<procedural::Perturbation> perturbationOf(const RenderOptions& o) {
     return p;
 }
 
+// The files a render reads that are not the scene file itself: its lesson bases are read with it; models and textures.
+std::vector<tools::NamedPath> sceneInputs(const scenes::SceneDesc& desc) {
+    std::vector<tools::NamedPath> inputs;
+    for (const scenes::ModelDesc& m : desc.models) inputs.push_back({"model file", m.file.string()});
+    for (const scenes::GlobalArgumentDesc& a : desc.globalArguments)
+        for (const auto& e : a.table)
+            if (e.isTexture && !e.texture.empty()) inputs.push_back({"texture", e.texture.string()});
+    return inputs;
+}
+
 int runRender(const RenderOptions& o) {
+    // Every output checked against the inputs and each other before anything is rendered.
+    std::vector<tools::NamedPath> inputs;
+    if (o.scene != "builtin") inputs.push_back({"scene file", o.scene});
+    std::vector<tools::NamedPath> outputs{{"-o", o.output}, {"--stats-json", o.statsJson}};
+    if (o.orderCheck > 0) outputs.push_back({"order mask (from -o)", scenes::orderMaskPath(o.output)});
+    tools::checkOutputs(inputs, outputs);
+
     scenes::RenderSettings settings;
     settings.threads = o.threads;
     settings.adversarialSeed = o.seed;
@@ -329,6 +348,10 @@ int runRender(const RenderOptions& o) {
         else result = renderOnce(settings);
     } else {
         std::unique_ptr<scenes::Scene> scene = scenes::loadScene(o.scene);
+        const std::vector<tools::NamedPath> read = sceneInputs(scene->desc());
+        inputs.insert(inputs.end(), read.begin(), read.end());
+        tools::checkOutputs(inputs, outputs);
+        tools::reportBuildWarnings("render", scene->buildWarnings(), o.warningsAsErrors);
         effectSet = scenes::computeEffects(scene->desc(), settings);
         effects = effectSet.list();
         const Size size = o.size.empty() ? Size{scene->desc().defaultWidth, scene->desc().defaultHeight} : parseSize(o.size);
@@ -360,10 +383,8 @@ int runRender(const RenderOptions& o) {
     if (statistics) {
         statistics->mean.metadata["refray_version"] = tools::kVersion;
         statistics->mean.metadata["refray_commit"] = tools::kCommit;
-        statistics->mean.metadata["threads"] = std::to_string(o.threads);
+        statistics->mean.metadata["threads"] = std::to_string(tools::threadsRun(o.threads));
         for (const auto& [key, value] : device.provenance) statistics->mean.metadata[key] = value;
-        const auto parent = std::filesystem::path(o.output).parent_path();
-        if (!parent.empty()) std::filesystem::create_directories(parent);
         writeStatisticsImage(o.output, *statistics);
         const bool noVariance = std::all_of(statistics->varianceOfMean.begin(), statistics->varianceOfMean.end(),
                                             [](const vec3& v) { return v == vec3(0.0f); });
@@ -374,7 +395,7 @@ int runRender(const RenderOptions& o) {
     } else {
         result.image.metadata["refray_version"] = tools::kVersion;
         result.image.metadata["refray_commit"] = tools::kCommit;
-        result.image.metadata["threads"] = std::to_string(o.threads);
+        result.image.metadata["threads"] = std::to_string(tools::threadsRun(o.threads));
         result.image.metadata["render_seconds"] = std::to_string(result.dispatch.seconds);
         for (const auto& [key, value] : device.provenance) result.image.metadata[key] = value;
         writeOutput(o.output, result.image);
@@ -448,6 +469,7 @@ int main(int argc, char** argv) {
                        "Render K >= 2 times with seeds S, S+1, ..., S+K-1 and write a statistics image (-o FILE.exr: "
                        "the mean and the variance of the mean) for 'refray compare --statistical'")
         ->check(tools::wholeNumber("a number of renders (2 or more)"));
+    render->add_flag("--warnings-as-errors", ro.warningsAsErrors, refray::tools::kWarningsAsErrorsHelp);
     render->add_flag("--stats", ro.stats,
                      "Print rays per ray type and depth, invocations per export, and the exclusive time per stage");
     render->add_option("--stats-json", ro.statsJson, "Write the --stats measures to FILE as JSON (format refray-stats/1)");
@@ -498,6 +520,8 @@ int main(int argc, char** argv) {
     bool devicesJson = false;
     devices->add_flag("--json", devicesJson, "Print the list as JSON (format refray-devices/1)");
 
+    // An output being written when the user interrupts refray is removed, and the file it replaces stays as it was.
+    refray::removeTemporaryFilesOnSignal();
     try {
         app.parse(argc, argv);
         if (*golden) return refray::tools::runGolden(goldenOptions);
@@ -515,6 +539,15 @@ int main(int argc, char** argv) {
     } catch (const refray::Error& e) {
         std::fprintf(stderr, "refray: %s\n", e.what());
         return 2;
+    } catch (const std::filesystem::filesystem_error& e) {
+        // A folder that cannot be created or removed (a full disk, a file in the way, no permission): the file's
+        // problem, named, not refray's.
+        std::fprintf(stderr, "refray: cannot use '%s': %s\n", e.path1().string().c_str(), e.code().message().c_str());
+        return 2;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "refray: not enough memory for this command (std::bad_alloc); a smaller --size, fewer "
+                             "renders or a machine with more memory may do\n");
+        return 3;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "refray: unexpected error: %s\n", e.what());
         return 3;

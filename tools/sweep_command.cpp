@@ -144,6 +144,8 @@ int runSweep(const SweepCommandOptions& o) {
 
     REFRAY_CHECK(!o.scene.empty(), "refray sweep needs a scene file (or --collect DIR / --job ID)");
     REFRAY_CHECK(!o.knobs.empty(), "refray sweep needs at least one --knob NAME=v1,v2,...; knobs:\n" << knobList());
+    checkOutputs({{"scene file", o.scene}},
+                 {{"--emit-jobs", o.emitJobs}, {"plan.json (in -o)", (fs::path(o.output) / "plan.json").string()}});
     scenes::SweepPlan plan;
     plan.scene = o.scene;
     plan.camera = o.camera;

@@ -419,6 +419,7 @@ CLI::App* addTableCommand(CLI::App& app, TableCommandOptions& o) {
         ->capture_default_str();
     sub->add_flag("--json", o.json, "Print JSON instead of text");
     sub->add_flag("--check", o.check, "Exit with status 1 when there is an error-level finding");
+    sub->add_flag("--warnings-as-errors", o.warningsAsErrors, kWarningsAsErrorsHelp);
     return sub;
 }
 
@@ -427,6 +428,7 @@ int runTable(const TableCommandOptions& o) {
         const std::optional<procedural::Precision> precision = procedural::parsePrecision(o.precision);
         REFRAY_CHECK(precision, "--precision expects 'float' or 'double', got '" << o.precision << "'");
         const std::unique_ptr<scenes::Scene> scene = scenes::loadScene(o.scene);
+        reportBuildWarnings("table", scene->buildWarnings(), o.warningsAsErrors);
         const TableView view = scenes::buildTableView(*scene, *precision);
         const std::string text = o.json ? formatTableJson(view) : formatTableText(view);
         std::fwrite(text.data(), 1, text.size(), stdout);

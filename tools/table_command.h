@@ -22,6 +22,7 @@ struct TableCommandOptions {
     std::string precision = "float";
     bool json = false;
     bool check = false;
+    bool warningsAsErrors = false;  // --warnings-as-errors
 };
 
 // Adds the `table` subcommand to `app`; app.parse() fills `options`, which must outlive the parse.

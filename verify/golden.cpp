@@ -4,9 +4,12 @@
 #include <chrono>
 #include <cstring>
 #include <fstream>
+#include <iomanip>
+#include <random>
 #include <sstream>
 
 #include "core/error.h"
+#include "core/file_input.h"
 #include "core/hash.h"
 #include "core/json.h"
 #include "core/strings.h"
@@ -138,10 +141,7 @@ void writeGoldenManifest(const fs::path& manifest, const GoldenSet& set) {
     }
     out << "\n}\n";
     // json::Value's asFloat reads the time back from its text; the manifest keeps times as strings so no digit is lost.
-    std::ofstream file(manifest, std::ios::binary);
-    REFRAY_CHECK(file, "cannot write " << manifest.string());
-    file << out.str();
-    REFRAY_CHECK(file.good(), "cannot write " << manifest.string());
+    writeTextFile(manifest.string(), out.str());
 }
 
 RenderSettings goldenSettings(const GoldenEntry& entry, uint32_t threads) {
@@ -403,6 +403,7 @@ const char* const kPlanMode[] = {"make", "update"};
 GoldenEntry makeGolden(const GoldenMakeOptions& options) {
     GoldenEntry e = planMake(options);
     Scene scene(loadSceneFile(options.sceneFile));
+    if (options.onSceneBuilt) options.onSceneBuilt(scene);
     fs::create_directories(options.goldenDirectory);
     const Envelope envelope = renderEnvelope(scene, e, options.render);
     const fs::path manifest = options.goldenDirectory / "goldens.json";
@@ -412,13 +413,60 @@ GoldenEntry makeGolden(const GoldenMakeOptions& options) {
     return e;
 }
 
-void writeGoldenPlan(const fs::path& goldenDirectory, const std::vector<GoldenEntry>& entries, bool update) {
+namespace {
+
+// What a job's render must have been made for: the settings of its golden as the plan states them.
+std::string planSettings(const GoldenEntry& e) {
+    std::ostringstream s;
+    s << "scene " << e.scene << " (SHA-256 " << e.sceneSha256 << "), camera " << e.camera << ", time " << e.time
+      << ", " << e.width << "x" << e.height << ", precision " << e.precision << ", spp " << e.spp << ", orders "
+      << e.orders << ", perturbed " << e.perturbedRenders;
+    return s.str();
+}
+
+std::string newPlanId() {
+    std::random_device device;
+    std::ostringstream id;
+    id << std::hex << std::setfill('0');
+    for (int i = 0; i < 4; ++i) id << std::setw(8) << device();
+    return id.str();
+}
+
+std::string readPlanId(const fs::path& jobs) {
+    std::string text = readInputFile((jobs / "plan-id").string(), "golden plan id", 1024);
+    while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
+    return text;
+}
+
+}  // namespace
+
+std::string writeGoldenPlan(const fs::path& goldenDirectory, const std::vector<GoldenEntry>& entries, bool update) {
     const fs::path jobs = goldenDirectory / "jobs";
-    fs::create_directories(jobs);
+    std::string id;
+    if (fs::exists(jobs / "plan.json")) {
+        // A plan is already there: the same one keeps its id (its finished renders stay valid); another one is refused
+        // rather than mixed with it or thrown away.
+        const GoldenSet old = readGoldenManifest(jobs / "plan.json");
+        std::string oldMode = readInputFile((jobs / "mode").string(), "golden plan mode", 1024);
+        const bool same = old.entries.size() == entries.size() && oldMode == std::string(kPlanMode[update]) + "\n" &&
+                          std::equal(old.entries.begin(), old.entries.end(), entries.begin(),
+                                     [](const GoldenEntry& a, const GoldenEntry& b) {
+                                         return a.name == b.name && planSettings(a) == planSettings(b);
+                                     });
+        std::string names;
+        for (const GoldenEntry& e : old.entries) names += (names.empty() ? "" : ", ") + e.name + " (" + planSettings(e) + ")";
+        REFRAY_CHECK(same, jobs.string() << " holds another plan (" << names << ") whose renders would be mixed with "
+                                         << "this one's; collect it first ('--collect') or remove " << jobs.string()
+                                         << " to discard it");
+        if (fs::exists(jobs / "plan-id")) id = readPlanId(jobs);
+    }
+    if (id.empty()) id = newPlanId();
     GoldenSet plan;
     plan.entries = entries;
     writeGoldenManifest(jobs / "plan.json", plan);
     writeTextFile((jobs / "mode").string(), std::string(kPlanMode[update]) + "\n");
+    writeTextFile((jobs / "plan-id").string(), id + "\n");
+    return id;
 }
 
 std::vector<std::string> goldenJobCommands(const fs::path& goldenDirectory, const fs::path& repositoryRoot,
@@ -438,7 +486,7 @@ fs::path goldenJobOutput(const fs::path& goldenDirectory, const std::string& nam
 }
 
 void runGoldenJob(const fs::path& goldenDirectory, const fs::path& repositoryRoot, const std::string& name,
-                  const std::string& part, uint32_t threads) {
+                  const std::string& part, uint32_t threads, const SceneBuiltCallback& onSceneBuilt) {
     const fs::path planFile = goldenDirectory / "jobs" / "plan.json";
     REFRAY_CHECK(fs::exists(planFile), goldenDirectory.string() << " holds no golden plan (no jobs/plan.json); write "
                                                                    "one with 'refray golden update --emit-jobs FILE'");
@@ -456,24 +504,28 @@ void runGoldenJob(const fs::path& goldenDirectory, const fs::path& repositoryRoo
                  (repositoryRoot / entry->scene).string() << " changed since the plan was written (SHA-256 "
                                                           << scene.desc().fileHash << ", planned " << entry->sceneSha256
                                                           << "); write the plan again");
+    if (onSceneBuilt) onSceneBuilt(scene);
     const auto start = std::chrono::steady_clock::now();
     Image image = renderEnvelopePart(scene, *p);
     image.metadata["golden_job_seconds"] = fixed(secondsSince(start));
-    const fs::path out = goldenJobOutput(goldenDirectory, name, part);
-    fs::create_directories(out.parent_path());
-    // Written under a temporary name and renamed: a job killed half-way leaves no file that looks finished.
-    const fs::path partial = out.parent_path() / (part + ".partial.exr");
-    writeImage(partial.string(), image);
-    fs::rename(partial, out);
+    // Where the render comes from, for collectGoldens to verify.
+    image.metadata["golden_plan_id"] = readPlanId(goldenDirectory / "jobs");
+    image.metadata["golden_job"] = name + " " + part;
+    image.metadata["golden_plan_settings"] = planSettings(*entry);
+    // writeImage writes the file whole or not at all: a job killed half-way leaves no file that looks finished.
+    writeImage(goldenJobOutput(goldenDirectory, name, part).string(), image);
 }
 
 GoldenSet collectGoldens(const fs::path& goldenDirectory, const std::function<void(const GoldenEntry&)>& onEntry) {
     const fs::path jobs = goldenDirectory / "jobs";
     REFRAY_CHECK(fs::exists(jobs / "plan.json"), goldenDirectory.string() << " holds no golden plan (no jobs/plan.json)");
     const GoldenSet plan = readGoldenManifest(jobs / "plan.json");
-    std::ifstream modeFile(jobs / "mode");
-    std::string mode;
-    modeFile >> mode;
+    std::string mode = readInputFile((jobs / "mode").string(), "golden plan mode", 1024);
+    while (!mode.empty() && (mode.back() == '\n' || mode.back() == '\r')) mode.pop_back();
+    REFRAY_CHECK(fs::exists(jobs / "plan-id"), (jobs / "plan-id").string()
+                                                   << " is missing: the plan was written by an older refray; write it "
+                                                      "again");
+    const std::string planId = readPlanId(jobs);
     REFRAY_CHECK(mode == kPlanMode[0] || mode == kPlanMode[1], (jobs / "mode").string() << " says '" << mode
                                                                   << "', not 'make' or 'update'");
     // Every render first: a missing one is named with the line that makes it, before anything is written.
@@ -496,7 +548,25 @@ GoldenSet collectGoldens(const fs::path& goldenDirectory, const std::function<vo
         std::map<std::string, Image> renders;
         std::map<std::string, double> seconds;
         for (const EnvelopePart& part : envelopeParts(e, 0)) {
-            Image image = readImage(goldenJobOutput(goldenDirectory, e.name, part.name).string());
+            const std::string file = goldenJobOutput(goldenDirectory, e.name, part.name).string();
+            Image image = readImage(file);
+            const auto meta = [&image](const char* key) {
+                const auto it = image.metadata.find(key);
+                return it == image.metadata.end() ? std::string("(none)") : it->second;
+            };
+            REFRAY_CHECK(meta("golden_plan_id") == planId,
+                         file << " was not rendered for this plan (its plan id is " << meta("golden_plan_id")
+                              << ", the plan's " << planId
+                              << "): a stale render of an earlier plan or a foreign file; delete it and run its line "
+                                 "again: refray golden job DIR "
+                              << e.name << " " << part.name);
+            REFRAY_CHECK(meta("golden_job") == e.name + " " + part.name && meta("golden_plan_settings") == planSettings(e) &&
+                             image.width() == e.width && image.height() == e.height,
+                         file << " is the render '" << meta("golden_job") << "' with settings '"
+                              << meta("golden_plan_settings") << "' (" << image.width() << "x" << image.height()
+                              << "), not '" << e.name << " " << part.name << "' with '" << planSettings(e)
+                              << "'; delete it and run its line again");
+            for (const char* key : {"golden_plan_id", "golden_job", "golden_plan_settings"}) image.metadata.erase(key);
             const auto t = image.metadata.find("golden_job_seconds");
             seconds[part.name] = t == image.metadata.end() ? 0.0 : std::stod(t->second);
             if (t != image.metadata.end()) image.metadata.erase(t);
@@ -553,6 +623,7 @@ GoldenSet updateGoldens(const GoldenUpdateOptions& options) {
         if (!scene || sceneFile != e.scene) {
             scene = std::make_unique<Scene>(loadSceneFile(options.repositoryRoot / e.scene));
             sceneFile = e.scene;
+            if (options.onSceneBuilt) options.onSceneBuilt(*scene);
         }
         EnvelopeRenderOptions render;
         render.threads = options.threads;

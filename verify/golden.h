@@ -93,6 +93,10 @@ struct EnvelopeRenderOptions {
     std::function<void(const std::string& what, double seconds)> onRender;
 };
 
+// Called once per scene built (makeGolden, updateGoldens, runGoldenJob) with its build warnings
+// (Scene::buildWarnings), for the command line to show; may throw to stop.
+using SceneBuiltCallback = std::function<void(const Scene&)>;
+
 // Renders the envelope of a golden entry's settings: the nominal render, entry.perturbedRenders perturbed ones
 // (goldenPerturbation(1..K)), one with --precision double and entry.orders adversarial orders (the order mask); fills
 // entry.orderDependentPixels and entry.sensitivePixels; the provenance names the settings, seeds, commit, variation
@@ -130,6 +134,7 @@ struct GoldenMakeOptions {
     uint32_t perturbedRenders = kDefaultPerturbedRenders;
     std::string refrayCommit;
     EnvelopeRenderOptions render;
+    SceneBuiltCallback onSceneBuilt;
 };
 GoldenEntry makeGolden(const GoldenMakeOptions& options);
 
@@ -144,6 +149,7 @@ struct GoldenUpdateOptions {
     std::function<void(const std::string& what, double seconds)> onRender;  // each render of each envelope
     std::function<void(const GoldenEntry&, double seconds)> onEntry;  // after each entry is written
     std::function<void(const StatisticalGoldenEntry&, double seconds)> onStatisticalEntry;
+    SceneBuiltCallback onSceneBuilt;
 };
 
 // Renders the envelope of every top-level scenes/*.json x camera at the scene's default time, writes
@@ -162,12 +168,20 @@ GoldenEntry planMake(const GoldenMakeOptions& options);
 // ("REFRAY golden job DIR NAME PART"); runGoldenJob renders one into <dir>/jobs/<name>/<part>.exr; collectGoldens
 // assembles the envelopes and the manifest from them, bit-identical to the in-process run but for the
 // render_seconds_* provenance. Statistical goldens are not planned: an update keeps them as they are.
-void writeGoldenPlan(const std::filesystem::path& goldenDirectory, const std::vector<GoldenEntry>& entries,
-                     bool update);
+//
+// Every plan has an id (<dir>/jobs/plan-id, random); each job's render carries it with the golden's name, the part and
+// the plan's settings for that golden (scene SHA-256, camera, time, size, precision, spp, orders, K), and
+// collectGoldens refuses, by name, a render that does not carry exactly those: a stale render of an earlier plan or a
+// foreign file dropped into jobs/. writeGoldenPlan refuses (refray::Error naming the folder and the plan there) to
+// plan into a folder whose jobs/ holds a different plan, so that two plans' renders never mix; the same plan again
+// keeps its id and its finished renders. Returns the plan id.
+std::string writeGoldenPlan(const std::filesystem::path& goldenDirectory, const std::vector<GoldenEntry>& entries,
+                            bool update);
 std::vector<std::string> goldenJobCommands(const std::filesystem::path& goldenDirectory,
                                            const std::filesystem::path& repositoryRoot, const std::string& refray);
 void runGoldenJob(const std::filesystem::path& goldenDirectory, const std::filesystem::path& repositoryRoot,
-                  const std::string& name, const std::string& part, uint32_t threads);
+                  const std::string& name, const std::string& part, uint32_t threads,
+                  const SceneBuiltCallback& onSceneBuilt = {});
 // Throws refray::Error listing the missing renders (and the lines that make them) before writing anything; on success
 // removes <dir>/jobs.
 GoldenSet collectGoldens(const std::filesystem::path& goldenDirectory,

@@ -1,13 +1,53 @@
 // "cameras", and the rest of what a frame is rendered with: "light", "time" and "effects".
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "core/error.h"
 #include "core/strings.h"
 #include "scenes/camera_models.h"
 #include "scenes/loader/parse_context.h"
+#include "procedural/sample_layout.h"
 
 namespace refray::scenes::loader {
+
+namespace {
+
+std::string pointText(const glm::dvec3& p) {
+    std::ostringstream s;
+    s << p.x << ", " << p.y << ", " << p.z;
+    return s.str();
+}
+
+// The camera rays the shaders make (GenerateCameraRay: a screen position through projectionToWorld, divided by w,
+// minus the eye), in float as on a GPU, at the screen's corners and centre: a camera whose rays overflow is refused at
+// load instead of stopping the render with a RAY-5 error that names no file.
+void checkCameraRays(const CameraDesc& c, const procedural::Float4x4& projectionToWorld) {
+    const glm::vec3 eye(c.eye);
+    REFRAY_CHECK(std::isfinite(eye.x) && std::isfinite(eye.y) && std::isfinite(eye.z),
+                 "camera " << inQuotes(c.name) << ": its rays overflow float: the eye (" << pointText(c.eye)
+                           << ", after rotateYDegrees) is beyond float's range (+-3.4e38), so the shaders' ray origin "
+                              "would be infinite");
+    const auto& m = projectionToWorld.m;
+    const glm::vec2 screens[] = {{-1, -1}, {1, -1}, {-1, 1}, {1, 1}, {0, 0}};
+    for (const glm::vec2 screen : screens) {
+        const float in[4] = {screen.x, screen.y, 0.0f, 1.0f};
+        float world[4] = {0, 0, 0, 0};
+        for (int j = 0; j < 4; ++j)
+            for (int i = 0; i < 4; ++i) world[j] += in[i] * m[size_t(i)][size_t(j)];
+        const glm::vec3 direction = glm::vec3(world[0], world[1], world[2]) / world[3] - eye;
+        const float length = glm::length(direction);
+        REFRAY_CHECK(std::isfinite(length) && length > 0.0f && std::isfinite(direction.x / length) &&
+                         std::isfinite(direction.y / length) && std::isfinite(direction.z / length),
+                     "camera " << inQuotes(c.name) << ": its rays overflow float (the ray through screen position ("
+                               << screen.x << ", " << screen.y << ") has direction (" << direction.x << ", "
+                               << direction.y << ", " << direction.z << ")); eye (" << pointText(c.eye) << "), target ("
+                               << pointText(c.target) << "), near " << c.nearZ << ", far " << c.farZ
+                               << ": bring them within float's range");
+    }
+}
+
+}  // namespace
 
 void parseCameras(ParseContext& ctx, const Value& value, const Value* defaultCamera) {
     std::vector<std::string> names;
@@ -20,7 +60,12 @@ void parseCameras(ParseContext& ctx, const Value& value, const Value* defaultCam
         const uint32_t model = resolveName(r.required("model"), {"miniengine", "directxmath-lh"}, "camera model");
         c.model = model == 0 ? CameraModel::MiniEngine : CameraModel::DirectXMathLH;
         c.eye = doubleVector3(r.required("eye"), "eye");
-        c.target = doubleVector3(r.required("target"), "target");
+        const Value& target = r.required("target");
+        c.target = doubleVector3(target, "target");
+        // Checked first, so that neither 'up' nor 'upFromRight' is blamed for a view direction that does not exist.
+        if (c.target == c.eye)
+            target.fail("camera " + inQuotes(c.name) + ": eye and target are the same point (" + pointText(c.eye) +
+                        "), so the camera has no view direction");
         const Value* up = r.optional("up");
         const Value* upFromRight = r.optional("upFromRight");
         if (up && upFromRight) upFromRight->fail("give 'up' or 'upFromRight', not both");
@@ -51,7 +96,8 @@ void parseCameras(ParseContext& ctx, const Value& value, const Value* defaultCam
         c.farZ = finiteNumber(r.required("far"), "far");
         r.finish();
         try {
-            projectionToWorld(c, 16, 9);  // validates the camera here, where its file position is known
+            // Validates the camera here, where its file position is known: the matrix, then the rays.
+            checkCameraRays(c, projectionToWorld(c, 16, 9));
         } catch (const Error& e) {
             v.fail(e.what());
         }

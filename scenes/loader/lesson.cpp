@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "core/file_input.h"
 #include "core/json_writer.h"
 #include "scenes/loader/parse_context.h"
 #include "scenes/scene_loader.h"
@@ -25,9 +26,12 @@ Value resolveLesson(Value root, const std::string& fileName, uint32_t depth, std
     const Value* expect = r.optional("expect");
     r.finish();
     const std::filesystem::path basePath = std::filesystem::path(fileName).parent_path() / base.asString();
-    std::ifstream in(basePath, std::ios::binary);
-    if (!in) base.fail("cannot read the lesson's base " + basePath.string() + ": " + std::strerror(errno));
-    const std::string baseText((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::string baseText;
+    try {
+        baseText = readInputFile(basePath.string(), "the lesson's base");
+    } catch (const Error& e) {
+        base.fail(e.what());
+    }
     hashed += baseText;
     LessonDesc inner;
     Value document = resolveLesson(json::parse(baseText, basePath.string()), basePath.string(), depth + 1, hashed, inner);

@@ -364,7 +364,7 @@ TEST(Json, ObjectReaderNeedsAnObject) {
 
 TEST(Json, ParseFileReportsMissingFile) {
     EXPECT_EQ(errorOf([] { parseFile("/nonexistent-refray-dir/scene.json"); }),
-              "cannot read /nonexistent-refray-dir/scene.json: No such file or directory");
+              "cannot read JSON file '/nonexistent-refray-dir/scene.json': no such file or directory");
 }
 
 TEST(Json, ParseFileNamesTheFileInLocations) {

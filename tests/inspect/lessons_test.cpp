@@ -108,7 +108,7 @@ TEST(LessonFormat, PatchErrorsPointAtTheLesson) {
 TEST(LessonFormat, AMissingBaseIsNamed) {
     const std::string text = R"({"format": "refray-lesson/1", "name": "x", "base": "nowhere.json", "title": "t", "patch": []})";
     const std::string error = testing::loadError(text);
-    EXPECT_CONTAINS(error, "broken.json:1:52: cannot read the lesson's base nowhere.json");
+    EXPECT_CONTAINS(error, "broken.json:1:52: cannot read the lesson's base 'nowhere.json': no such file or directory");
 }
 
 }  // namespace

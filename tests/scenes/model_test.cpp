@@ -286,6 +286,25 @@ TEST(Model, UnreadableAndEmptyFilesAreNamed) {
     EXPECT_CONTAINS(empty, "points.obj holds no triangle");
 }
 
+TEST(Model, CoordinatesAndIndicesThatAreNotFiniteNumbersNameTheLine) {
+    const fs::path dir = freshDir("bad-numbers");
+    const auto error = [&](const std::string& lines) {
+        return errorOf([&] { loadObjModel(writeFile(dir / "bad.obj", "v 0 0 0\nv 1 0 0\n" + lines + "\nf 1 2 3\n")); });
+    };
+    EXPECT_CONTAINS(error("v nan 1 0"), "bad.obj:3: v statement: value 1 is 'nan', which is not a finite number");
+    EXPECT_CONTAINS(error("v 0 oops 0"), "bad.obj:3: v statement: value 2 is 'oops', not a number");
+    EXPECT_CONTAINS(error("v 0 1 inf"), "bad.obj:3: v statement: value 3 is 'inf', which is not a finite number");
+    EXPECT_CONTAINS(error("v 0 1e39 0"), "bad.obj:3: v statement: value 2 is '1e39', which is not a finite number");
+    EXPECT_CONTAINS(error("v 0 1 0\nvn 0 0 1x"), "bad.obj:4: vn statement: value 3 is '1x', not a number");
+    EXPECT_CONTAINS(error("v 0 1"), "bad.obj:3: v statement has 2 values; it needs at least 3");
+    const std::string index = errorOf([&] {
+        loadObjModel(writeFile(dir / "bad-index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3x\n"));
+    });
+    EXPECT_CONTAINS(index, "bad-index.obj:4: face refers to vertex '3x', which is not a whole number");
+    // What is fine stays fine: signs, exponents, a w and vertex colours.
+    EXPECT_NO_THROW(loadObjModel(writeFile(dir / "good.obj", "v -0 +1 2e-3 1\nv 1 0 0 0.5 0.5 0.5\nv 0 1 0\nf 1 2 3\n")));
+}
+
 TEST(Model, FacesReferringToMissingDataNameTheLine) {
     const fs::path dir = freshDir("bad-faces");
     const std::string head = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n";  // 3 v, 1 vt, 1 vn; faces on line 6

@@ -237,7 +237,8 @@ TEST(SceneLoader, BadRegisterAndCameraAreNamed) {
     EXPECT_CONTAINS(loadError(edited("\"register\": \"t3\"", "\"register\": \"b3\"")),
                     "parameter 'g_instanceBuffer' binds a 't' register, got 'b3'");
     EXPECT_CONTAINS(loadError(edited("\"eye\": [90, 5, 215], \"target\": [0, -50, 115]", "\"eye\": [0, -50, 115], \"target\": [0, -50, 115]")),
-                    "camera 'mandelbulb': the view direction is degenerate");
+                    "broken.json:133:83: camera 'mandelbulb': eye and target are the same point (0, -50, 115), so the "
+                    "camera has no view direction");
     EXPECT_CONTAINS(loadError(edited("\"defaultCamera\": \"overview\"", "\"defaultCamera\": \"overveiw\"")),
                     "unknown camera 'overveiw' (did you mean 'overview'?)");
 }

@@ -106,7 +106,8 @@ TEST(RefrayCli, SceneOptionsAreCheckedByName) {
     EXPECT_NE(r.output.find("--spp must be a square number"), std::string::npos) << r.output;
     r = run("render no-such-scene.json -o " + outputPath("never.png"));
     EXPECT_EQ(r.status, 2);
-    EXPECT_NE(r.output.find("cannot read scene file no-such-scene.json"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("cannot read scene file 'no-such-scene.json': no such file or directory"), std::string::npos)
+        << r.output;
 }
 
 // ---- Parse errors: exit status 2 and a message naming the command, the option and what it accepts ----
@@ -136,16 +137,16 @@ TEST(RefrayCliParseErrors, CompareNamesTheOptionAndWhatItAccepts) {
 
 TEST(RefrayCliParseErrors, GoldenUpdateNamesTheOptionAndWhatItAccepts) {
     expectBadInput("golden update --threads many",
-                   "refray golden update: --threads: expects a number of worker threads (0: all), got 'many'");
+                   "refray golden update: --threads: expects a number of worker threads from 0 (all) to ");
 }
 
 TEST(RefrayCliParseErrors, GoldenMakeJobAndDiscriminateNameTheOptionAndWhatItAccepts) {
     expectBadInput("golden make scene.json -o dir --perturbed -2",
-                   "refray golden make: --perturbed: expects a number of perturbed renders, got '-2'");
+                   "refray golden make: --perturbed: expects a number of perturbed renders from 3 to 1000");
     expectBadInput("golden job dir name nominal --threads x",
-                   "refray golden job: --threads: expects a number of worker threads (0: all), got 'x'");
+                   "refray golden job: --threads: expects a number of worker threads from 0 (all) to ");
     expectBadInput("golden discriminate --threads x",
-                   "refray golden discriminate: --threads: expects a number of worker threads (0: all), got 'x'");
+                   "refray golden discriminate: --threads: expects a number of worker threads from 0 (all) to ");
 }
 
 TEST(RefrayCliParseErrors, TableNamesTheOptionAndWhatItAccepts) {
