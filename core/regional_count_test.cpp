@@ -36,6 +36,14 @@ double upperTail(uint64_t y, uint64_t n, double q) {
     return boost::math::cdf(boost::math::complement(binomial, double(y - 1)));
 }
 
+// Findings in the order a report names them: the smallest p first; of equal p, the smallest region (a tile before
+// its whole object), which says best where the damage is.
+bool moreSpecific(const RegionalFinding& a, const RegionalFinding& b) {
+    if (a.p != b.p) return a.p < b.p;
+    const uint32_t sa = a.tileSize ? a.tileSize : UINT32_MAX, sb = b.tileSize ? b.tileSize : UINT32_MAX;
+    return sa < sb;
+}
+
 uint64_t clusters(uint64_t pixels, double m) { return uint64_t(std::ceil(double(pixels) / m - 1e-9)); }
 
 }  // namespace
@@ -388,15 +396,14 @@ RegionalJudgement judgeRegions(const Envelope& e, const std::vector<int8_t>& can
             finding.clusterSize = m;
             finding.heterogeneity = h;
             finding.share = share;
-            if (j.closest.candidate == 0 || finding.p < j.closest.p) {
+            if (j.closest.candidate == 0 || moreSpecific(finding, j.closest)) {
                 j.closest = finding;
                 j.smallestAdjustedP = finding.adjustedP;
             }
             if (finding.adjustedP < options.falseAlarm) j.failing.push_back(finding);
         }
     }
-    std::stable_sort(j.failing.begin(), j.failing.end(),
-                     [](const RegionalFinding& a, const RegionalFinding& b) { return a.p < b.p; });
+    std::stable_sort(j.failing.begin(), j.failing.end(), moreSpecific);
     return j;
 }
 

@@ -73,6 +73,9 @@ std::vector<DiscriminationCandidate> makeCandidates() {
     // Mutants: scene data a back end uploads wrong (patches of the scene file).
     c.push_back({"diffuse-2pc", K::Mutant, "every material's diffuse coefficient 2 % low", "scene: diffuseCoef x 0.98"});
     c.push_back({"specular-3pc", K::Mutant, "every material's specular coefficient 3 % high", "scene: specularCoef x 1.03"});
+    c.push_back({"specular-power-one-material", K::Mutant,
+                 "one material's specular power one higher (the lowest one: D3D12's cog 2 -> 3)",
+                 "scene: the first material of the lowest specularPower, specularPower + 1"});
     c.push_back({"albedo-1pc", K::Mutant, "every material's albedo 1 % low", "scene: albedo.rgb x 0.99"});
     c.push_back({"reflectance-3pc", K::Mutant, "every material's reflectance 3 % low", "scene: reflectanceCoef x 0.97"});
     c.push_back({"ambient-2pc", K::Mutant, "the ambient light 2 % low", "scene: light.ambientColor.rgb x 0.98"});
@@ -141,6 +144,19 @@ std::string scenePatch(const json::Value& scene, const std::string& name) {
     else if (name == "specular-3pc") scaleMaterials("specularCoef", 1.03, false);
     else if (name == "albedo-1pc") scaleMaterials("albedo", 0.99, true);
     else if (name == "reflectance-3pc") scaleMaterials("reflectanceCoef", 0.97, false);
+    else if (name == "specular-power-one-material") {
+        const json::Value* values = scene.find("values");
+        REFRAY_CHECK(values && values->isObject(), "the scene has no 'values' to patch");
+        std::string lowest;
+        double power = 0;
+        for (const auto& member : values->asObject())
+            if (const json::Value* v = member.value.find("specularPower"); v && (lowest.empty() || v->asNumber() < power)) {
+                lowest = member.key;
+                power = v->asNumber();
+            }
+        REFRAY_CHECK(!lowest.empty(), "the scene has no material with a specularPower to patch");
+        replace("/values/" + lowest + "/specularPower", number(power + 1));
+    }
     else if (name == "ambient-2pc" || name == "light-y-flipped") {
         const json::Value* light = scene.find("light");
         REFRAY_CHECK(light, "the scene has no 'light' to patch");
