@@ -443,8 +443,9 @@ std::string discriminationMarkdown(const std::vector<DiscriminationRow>& rows) {
             if (!r.ran) continue;
             ++correct;
             falseAlarms += r.judgement.verdict == CompareVerdict::Fail;
-            if (r.judgement.regional.available &&
-                (!closest || r.judgement.regional.smallestAdjustedP < closest->judgement.regional.smallestAdjustedP))
+            // The closest by the unadjusted p of its most extreme region (the adjusted one is 1 for most).
+            if (r.judgement.regional.available && r.judgement.regional.closest.candidate > 0 &&
+                (!closest || r.judgement.regional.closest.p < closest->judgement.regional.closest.p))
                 closest = &r;
             continue;
         }
@@ -463,8 +464,10 @@ std::string discriminationMarkdown(const std::vector<DiscriminationRow>& rows) {
        << " by the regional count test alone (the whole-image counts pass them)";
     if (closest)
         md << "; the correct judgement closest to failing it: `" << closest->candidate.name << "` on "
-           << closest->golden << ", adjusted p " << pValue(closest->judgement.regional.smallestAdjustedP)
-           << " (FAILURE below " << pValue(closest->judgement.regional.falseAlarm) << ")";
+           << closest->golden << ", p " << pValue(closest->judgement.regional.closest.p) << " over "
+           << closest->judgement.regional.tests << " tests, adjusted "
+           << pValue(closest->judgement.regional.smallestAdjustedP) << " (FAILURE below "
+           << pValue(closest->judgement.regional.falseAlarm) << ")";
     md << ".\n\n";
 
     md << "Each cell: the verdict, then stable pixels moved / the stable budget, sensitive pixels outside / their "
