@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <sstream>
 
@@ -34,6 +35,20 @@ std::string countList(const std::vector<uint64_t>& counts) {
 constexpr const char kChannelLetters[] = "RGB";
 const std::vector<std::string> kChannelNames = {"R",    "G",    "B",    "A",     "lo.R", "lo.G",
                                                 "lo.B", "hi.R", "hi.G", "hi.B",  "class", "order"};
+// refray-envelope/2: the regional count test's planes (where K <= kMaxRegionalRenders).
+const std::vector<std::string> kRegionalChannelNames = {"object", "loo.stableUp", "loo.stableDown",
+                                                        "loo.sensitiveAbove", "loo.sensitiveBelow"};
+constexpr const char* kObjectsKey = "envelope_objects";
+
+// "id=name" per object, one a line.
+std::string objectNameList(const std::map<int32_t, std::string>& names) {
+    std::string list;
+    for (const auto& [id, name] : names) {
+        if (!list.empty()) list += '\n';
+        list += std::to_string(id) + "=" + name;
+    }
+    return list;
+}
 
 std::string sizeText(uint32_t w, uint32_t h) { return std::to_string(w) + "x" + std::to_string(h); }
 
@@ -46,7 +61,7 @@ uint64_t Envelope::sensitivePixels() const {
 }
 
 Envelope makeEnvelope(const Image& nominal, const std::vector<const Image*>& variants, uint32_t perturbedRenders,
-                      const Image* orderMask) {
+                      const Image* orderMask, const ObjectMap* objects) {
     REFRAY_CHECK(!nominal.empty(), "an envelope needs a nominal render");
     REFRAY_CHECK(perturbedRenders <= variants.size(),
                  perturbedRenders << " perturbed renders named but only " << variants.size() << " variants given");
@@ -59,6 +74,9 @@ Envelope makeEnvelope(const Image& nominal, const std::vector<const Image*>& var
         REFRAY_CHECK(orderMask->width() == w && orderMask->height() == h,
                      "an order mask of " << sizeText(orderMask->width(), orderMask->height()) << " for a nominal of "
                                          << sizeText(w, h));
+    if (objects)
+        REFRAY_CHECK(objects->ids.size() == size_t(w) * h,
+                     "an object map of " << objects->ids.size() << " pixels for a nominal of " << sizeText(w, h));
     Envelope e;
     e.nominal = nominal;
     e.perturbedRenders = perturbedRenders;
@@ -70,6 +88,15 @@ Envelope makeEnvelope(const Image& nominal, const std::vector<const Image*>& var
     e.orderDependent.assign(n, 0);
     e.stableMovesLeaveOneOut.assign(perturbedRenders, 0);
     e.sensitiveOutsideLeaveOneOut.assign(perturbedRenders, 0);
+    const bool regional = perturbedRenders <= kMaxRegionalRenders;
+    if (regional) {
+        if (objects) e.objects = *objects;
+        else {
+            e.objects.ids.assign(n, 0);
+            e.objects.names[0] = "the image";
+        }
+        for (auto& flags : e.leaveOneOutFlags) flags.assign(n, 0);
+    }
     const size_t renders = variants.size() + 1;  // index 0: the nominal
     std::vector<std::array<int, kEnvelopeChannels>> codes(renders);
     for (size_t i = 0; i < n; ++i) {
@@ -79,16 +106,20 @@ Envelope makeEnvelope(const Image& nominal, const std::vector<const Image*>& var
         }
         // Which renders move this pixel by more than one step in some channel: the leave-one-out calibration counts,
         // for perturbed render r, the pixels that r alone moves (stable over the nominal and every other render).
+        // The mover's direction is that of its channel furthest from the nominal, as a candidate's flag's is.
         size_t movers = 0, mover = 0;
-        for (size_t r = 1; r < renders; ++r)
+        bool moverUp = false;
+        for (size_t r = 1; r < renders; ++r) {
+            int furthest = 0;
             for (int c = 0; c < kEnvelopeChannels; ++c) {
                 const int d = codes[r][c] - codes[0][c];
-                if (d > 1 || d < -1) {
-                    ++movers;
-                    mover = r - 1;
-                    break;
-                }
+                if ((d > 1 || d < -1) && std::abs(d) > std::abs(furthest)) furthest = d;
             }
+            if (furthest == 0) continue;
+            ++movers;
+            mover = r - 1;
+            moverUp = furthest > 0;
+        }
         for (int c = 0; c < kEnvelopeChannels; ++c) {
             const int q = codes[0][c];
             int lo = q, hi = q;
@@ -105,11 +136,17 @@ Envelope makeEnvelope(const Image& nominal, const std::vector<const Image*>& var
             e.orderDependent[i] = (m.r != 0.0f || m.g != 0.0f || m.b != 0.0f) ? 1 : 0;
         }
         if (e.orderDependent[i]) continue;
-        if (movers == 1 && mover < perturbedRenders) ++e.stableMovesLeaveOneOut[mover];
+        if (movers == 1 && mover < perturbedRenders) {
+            ++e.stableMovesLeaveOneOut[mover];
+            // Such a pixel is sensitive in the full envelope (render i moved it), but for render i, as a candidate
+            // the envelope has not seen, it is a stable pixel moved: the regional test's stable flags are these.
+            if (regional) e.leaveOneOutFlags[int(flagFamily(false, moverUp))][i] |= 1u << mover;
+        }
         if (e.pixelClass[i] != PixelClass::Sensitive) continue;
         // The sensitive calibration: perturbed render r against the envelope of every other render, judged as a
         // candidate is (one step of slack beyond the bounds).
-        for (uint32_t r = 0; r < perturbedRenders; ++r)
+        for (uint32_t r = 0; r < perturbedRenders; ++r) {
+            int furthest = 0;  // signed steps outside, of the channel furthest out
             for (int c = 0; c < kEnvelopeChannels; ++c) {
                 int lo = INT_MAX, hi = INT_MIN;
                 for (size_t o = 0; o < renders; ++o) {
@@ -118,11 +155,13 @@ Envelope makeEnvelope(const Image& nominal, const std::vector<const Image*>& var
                     hi = std::max(hi, codes[o][c]);
                 }
                 const int q = codes[r + 1][c];
-                if (q < lo - 1 || q > hi + 1) {
-                    ++e.sensitiveOutsideLeaveOneOut[r];
-                    break;
-                }
+                const int steps = q < lo - 1 ? q - (lo - 1) : q > hi + 1 ? q - (hi + 1) : 0;
+                if (std::abs(steps) > std::abs(furthest)) furthest = steps;
             }
+            if (furthest == 0) continue;
+            ++e.sensitiveOutsideLeaveOneOut[r];
+            if (regional) e.leaveOneOutFlags[int(flagFamily(true, furthest > 0))][i] |= 1u << r;
+        }
     }
     return e;
 }
@@ -133,19 +172,29 @@ void writeEnvelope(const std::string& path, const Envelope& e) {
                      e.orderDependent.size() == n,
                  "cannot write the envelope '" << path << "': its planes do not match its " << sizeText(e.width(), e.height())
                                                << " nominal");
-    const int channels = int(kChannelNames.size());
+    const bool regional = !e.leaveOneOutFlags[0].empty();
+    if (regional)
+        for (const auto& flags : e.leaveOneOutFlags)
+            REFRAY_CHECK(flags.size() == n && e.objects.ids.size() == n,
+                         "cannot write the envelope '" << path << "': its regional planes do not match its "
+                                                       << sizeText(e.width(), e.height()) << " nominal");
+    std::vector<std::string> names = kChannelNames;
+    if (regional) names.insert(names.end(), kRegionalChannelNames.begin(), kRegionalChannelNames.end());
+    const int channels = int(names.size());
     OIIO::ImageSpec spec(int(e.width()), int(e.height()), channels, OIIO::TypeDesc::FLOAT);
-    spec.channelnames = kChannelNames;
+    spec.channelnames = names;
     spec.alpha_channel = 3;
     for (const auto& [key, value] : e.nominal.metadata) spec.attribute(kMetadataPrefix + key, value);
     for (const auto& [key, value] : e.provenance) spec.attribute(kMetadataPrefix + key, value);
-    spec.attribute(std::string(kMetadataPrefix) + kFormatKey, std::string(kEnvelopeFormat));
+    // Without the regional planes the file holds exactly what version 1 does, and says so.
+    spec.attribute(std::string(kMetadataPrefix) + kFormatKey, std::string(regional ? kEnvelopeFormat : kEnvelopeFormatV1));
     spec.attribute(std::string(kMetadataPrefix) + kPerturbedKey, std::to_string(e.perturbedRenders));
     spec.attribute(std::string(kMetadataPrefix) + kVariantsKey, std::to_string(e.variants));
     if (!e.stableMovesLeaveOneOut.empty())
         spec.attribute(std::string(kMetadataPrefix) + kStableMovesKey, countList(e.stableMovesLeaveOneOut));
     if (!e.sensitiveOutsideLeaveOneOut.empty())
         spec.attribute(std::string(kMetadataPrefix) + kSensitiveOutsideKey, countList(e.sensitiveOutsideLeaveOneOut));
+    if (regional) spec.attribute(std::string(kMetadataPrefix) + kObjectsKey, objectNameList(e.objects.names));
     spec.attribute("compression", "zip");
     spec.attribute("oiio:UnassociatedAlpha", 1);
     std::vector<float> data(n * channels);
@@ -158,6 +207,9 @@ void writeEnvelope(const std::string& path, const Envelope& e) {
         }
         p[10] = float(uint8_t(e.pixelClass[i]));
         p[11] = float(e.orderDependent[i]);
+        if (!regional) continue;
+        p[12] = float(e.objects.ids[i]);
+        for (int f = 0; f < kFlagFamilies; ++f) p[13 + f] = float(e.leaveOneOutFlags[f][i]);
     }
     writeImageFile(path, spec, OIIO::TypeDesc::FLOAT, data.data());
 }
@@ -193,7 +245,7 @@ Envelope readEnvelope(const std::string& path) {
         if (name.rfind(prefix, 0) == 0) metadata[name.substr(prefix.size())] = attribute.get_string();
     }
     const auto format = metadata.find(kFormatKey);
-    REFRAY_CHECK(format != metadata.end() && format->second == kEnvelopeFormat,
+    REFRAY_CHECK(format != metadata.end() && (format->second == kEnvelopeFormat || format->second == kEnvelopeFormatV1),
                  "the envelope '" << path << "' is of format '"
                                   << (format == metadata.end() ? std::string("none") : format->second)
                                   << "', this refray reads '" << kEnvelopeFormat
@@ -202,6 +254,14 @@ Envelope readEnvelope(const std::string& path) {
         REFRAY_CHECK(index[c] >= 0 || c == 3,
                      "the envelope '" << path << "' is corrupted: it lacks the channel " << kChannelNames[c]);
     Envelope e;
+    e.format = format->second;
+    int regionalIndex[5];
+    for (size_t c = 0; c < kRegionalChannelNames.size(); ++c) regionalIndex[c] = spec.channelindex(kRegionalChannelNames[c]);
+    // Version 2 holds every regional plane or (K > kMaxRegionalRenders) none; version 1 none.
+    const bool regional = e.format == kEnvelopeFormat && regionalIndex[0] >= 0;
+    for (size_t c = 0; regional && c < kRegionalChannelNames.size(); ++c)
+        REFRAY_CHECK(regionalIndex[c] >= 0,
+                     "the envelope '" << path << "' is corrupted: it lacks the channel " << kRegionalChannelNames[c]);
     try {
         e.perturbedRenders = uint32_t(std::stoul(metadata.at(kPerturbedKey)));
         e.variants = uint32_t(std::stoul(metadata.at(kVariantsKey)));
@@ -233,7 +293,7 @@ Envelope readEnvelope(const std::string& path) {
     e.orderDependent.resize(n);
     for (const auto& [key, value] : metadata)
         if (key != kFormatKey && key != kPerturbedKey && key != kVariantsKey && key != kStableMovesKey &&
-            key != kSensitiveOutsideKey)
+            key != kSensitiveOutsideKey && key != kObjectsKey)
             e.provenance[key] = value;
     const auto fail = [&](size_t i, const std::string& what) {
         REFRAY_CHECK(false, "the envelope '" << path << "' is corrupted at (" << i % uint32_t(spec.width) << ", "
@@ -245,8 +305,45 @@ Envelope readEnvelope(const std::string& path) {
             fail(i, channel + " = " + std::to_string(v) + " is no UNORM8 value (code/255)");
         return int(std::lround(scaled));
     };
+    if (regional) {
+        REFRAY_CHECK(e.perturbedRenders <= kMaxRegionalRenders,
+                     "the envelope '" << path << "' is corrupted: leave-one-out flags of " << e.perturbedRenders
+                                      << " perturbed renders (at most " << kMaxRegionalRenders << ")");
+        e.objects.ids.resize(n);
+        for (auto& flags : e.leaveOneOutFlags) flags.resize(n);
+        const auto names = metadata.find(kObjectsKey);
+        if (names != metadata.end()) {
+            std::istringstream lines(names->second);
+            for (std::string line; std::getline(lines, line);) {
+                const size_t eq = line.find('=');
+                REFRAY_CHECK(eq != std::string::npos && eq > 0,
+                             "the envelope '" << path << "' is corrupted: refray:" << kObjectsKey << " has the line '"
+                                              << line << "' (id=name)");
+                try {
+                    e.objects.names[int32_t(std::stol(line.substr(0, eq)))] = line.substr(eq + 1);
+                } catch (const std::exception&) {
+                    REFRAY_CHECK(false, "the envelope '" << path << "' is corrupted: refray:" << kObjectsKey
+                                                         << " has the line '" << line << "' (id=name)");
+                }
+            }
+        }
+    }
+    const uint64_t renderBits = e.perturbedRenders >= 32 ? ~0ull : (1ull << e.perturbedRenders) - 1;
     for (size_t i = 0; i < n; ++i) {
         const float* p = &data[i * channels];
+        if (regional) {
+            const float id = p[regionalIndex[0]];
+            if (!(id >= -1.0f && id < 16777216.0f) || id != std::floor(id))
+                fail(i, "object = " + std::to_string(id) + " is no object id");
+            e.objects.ids[i] = int32_t(id);
+            for (int f = 0; f < kFlagFamilies; ++f) {
+                const float bits = p[regionalIndex[1 + f]];
+                if (!(bits >= 0.0f && bits < 16777216.0f) || bits != std::floor(bits) || (uint64_t(bits) & ~renderBits))
+                    fail(i, kRegionalChannelNames[1 + f] + " = " + std::to_string(bits) + " is no mask of " +
+                                std::to_string(e.perturbedRenders) + " perturbed renders");
+                e.leaveOneOutFlags[f][i] = uint32_t(bits);
+            }
+        }
         e.nominal.pixels()[i] = vec4(p[index[0]], p[index[1]], p[index[2]], index[3] >= 0 ? p[index[3]] : 1.0f);
         for (int c = 0; c < 3; ++c) {
             const int lo = asCode(i, p[index[4 + c]], kChannelNames[4 + c]);
@@ -267,6 +364,21 @@ Envelope readEnvelope(const std::string& path) {
     e.nominal.metadata = e.provenance;
     return e;
 }
+
+namespace {
+
+// The failing regions' bounding boxes, outlined in cyan on the heat map (the most significant few).
+void outlineRegions(Image& heatMap, const RegionalJudgement& regional) {
+    constexpr size_t kOutlined = 3;
+    const vec4 cyan(0.0f, 1.0f, 1.0f, 1.0f);
+    for (size_t k = 0; k < std::min(kOutlined, regional.failing.size()); ++k) {
+        const RegionalFinding& f = regional.failing[k];
+        for (uint32_t x = f.x0; x <= f.x1; ++x) heatMap.at(x, f.y0) = heatMap.at(x, f.y1) = cyan;
+        for (uint32_t y = f.y0; y <= f.y1; ++y) heatMap.at(f.x0, y) = heatMap.at(f.x1, y) = cyan;
+    }
+}
+
+}  // namespace
 
 uint64_t leaveOneOutClusterSize(const std::vector<uint64_t>& counts, const EnvelopeJudgeOptions& options) {
     uint64_t cluster = std::max<uint32_t>(options.clusterSize, 1);
@@ -321,6 +433,7 @@ EnvelopeJudgement judgeEnvelope(const Envelope& e, const Image& candidate, const
     const size_t n = size_t(e.width()) * e.height();
     j.pixels = n;
     j.heatMap = Image(e.width(), e.height(), vec4(0.0f, 0.0f, 0.0f, 1.0f));
+    std::vector<int8_t> flags(n, kNoFlag);  // the regional test's: family by class and direction
     for (size_t i = 0; i < n; ++i) {
         const vec4& cv = candidate.pixels()[i];
         const vec4& nv = e.nominal.pixels()[i];
@@ -367,10 +480,12 @@ EnvelopeJudgement judgeEnvelope(const Envelope& e, const Image& candidate, const
             j.heatMap.pixels()[i] = vec4(0.2f, 0.4f, 1.0f, 1.0f);
         } else if (sensitive) {
             ++j.sensitiveOutside;
+            flags[i] = int8_t(flagFamily(true, px.candidate > px.allowedHi));
             const float t = std::min(1.0f, float(px.steps) / 32.0f);
             j.heatMap.pixels()[i] = vec4(1.0f, 0.55f + 0.45f * t, 0.1f + 0.5f * t, 1.0f);
         } else {
             ++j.stableOutside;
+            flags[i] = int8_t(flagFamily(false, px.candidate > px.allowedHi));
             j.heatMap.pixels()[i] = vec4(1.0f, 0.0f, 0.0f, 1.0f);
         }
         j.outside.push_back(px);
@@ -405,7 +520,11 @@ EnvelopeJudgement judgeEnvelope(const Envelope& e, const Image& candidate, const
         for (uint64_t c : e.stableMovesLeaveOneOut) total += c;
         j.expectedStableOutside = double(total) / double(e.stableMovesLeaveOneOut.size());
     }
-    if (j.nonFinite > 0 || j.stableOutside > j.stableBudget || j.sensitiveOutside > j.sensitiveBudget)
+    // The regional count test (core/regional_count_test.h): the verdict is the whole-image counts' OR its.
+    j.regional = judgeRegions(e, flags, {options.falseAlarm});
+    outlineRegions(j.heatMap, j.regional);
+    if (j.nonFinite > 0 || j.stableOutside > j.stableBudget || j.sensitiveOutside > j.sensitiveBudget ||
+        j.regional.failed())
         j.verdict = CompareVerdict::Fail;
     else if (double(j.sensitiveOutside) > j.expectedOutside || double(j.stableOutside) > j.expectedStableOutside)
         j.verdict = CompareVerdict::Warn;
@@ -458,10 +577,30 @@ std::string EnvelopeJudgement::describe(size_t listed) const {
         }
         if (worst.size() > listed) out << "    ... and " << worst.size() - listed << " more\n";
     }
+    if (!regional.available) {
+        out << "  regional        not judged: " << regional.unavailable << "\n";
+    } else {
+        char line[200];
+        std::snprintf(line, sizeof line,
+                      "  regional        %llu tests (%llu regions of %llu objects x 4 directions), smallest adjusted p %.3g"
+                      " (FAILURE below %.3g)\n",
+                      (unsigned long long)regional.tests, (unsigned long long)regional.regions,
+                      (unsigned long long)regional.objects, regional.smallestAdjustedP, regional.falseAlarm);
+        out << line;
+        if (regional.closest.candidate > 0 && !regional.failed())
+            out << "    closest: " << regional.closest.describe() << "\n";
+        for (size_t i = 0; i < std::min<size_t>(3, regional.failing.size()); ++i)
+            out << "    " << regional.failing[i].describe() << "\n";
+        if (regional.failing.size() > 3) out << "    ... and " << regional.failing.size() - 3 << " more regions\n";
+    }
     out << "  verdict         " << toString(verdict);
     if (verdict == CompareVerdict::Fail) {
         out << " (";
         if (nonFinite) out << "NaN or infinity; ";
+        if (regional.failed()) {
+            const RegionalFinding& f = regional.failing.front();
+            out << f.describe() << "; ";
+        }
         if (stableOutside > stableBudget)
             out << stableOutside << " stable pixels moved, more than " << stableBudget << " allowed; ";
         if (sensitiveOutside > sensitiveBudget)

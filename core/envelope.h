@@ -17,10 +17,14 @@
 
 #include "core/compare.h"
 #include "core/image.h"
+#include "core/regional_count_test.h"
 
 namespace refray {
 
-inline constexpr std::string_view kEnvelopeFormat = "refray-envelope/1";
+// Version 2 adds the regional count test's data (the object map and the leave-one-out flags); an envelope of
+// version 1 still loads and is judged by the whole-image counts alone, which its judgement says.
+inline constexpr std::string_view kEnvelopeFormat = "refray-envelope/2";
+inline constexpr std::string_view kEnvelopeFormatV1 = "refray-envelope/1";
 
 // One UNORM8 step: 1/255.
 inline constexpr int kEnvelopeChannels = 3;  // R, G, B are judged; alpha means nothing in the D3D12 samples
@@ -42,6 +46,11 @@ struct Envelope {
     // s_i, for perturbed render i: the sensitive pixels (order-dependent ones excepted) where render i falls outside
     // the envelope of the nominal and every other render by more than one step, as a candidate is judged.
     std::vector<uint64_t> sensitiveOutsideLeaveOneOut;
+    // The regional count test (core/regional_count_test.h): the nominal's objects, and per family and pixel which
+    // perturbed renders flag it by leave-one-out. Both empty for an envelope of refray-envelope/1.
+    ObjectMap objects;
+    LeaveOneOutFlags leaveOneOutFlags;
+    std::string format = std::string(kEnvelopeFormat);  // as read (written: always kEnvelopeFormat)
     std::map<std::string, std::string> provenance;  // settings, seeds, commit, variation model, scene SHA-256
 
     uint32_t width() const { return nominal.width(); }
@@ -51,16 +60,21 @@ struct Envelope {
 
 // The envelope of `nominal` and `variants` (all the same size; throws refray::Error naming the sizes otherwise):
 // bounds over the nominal and every variant, quantised with floatToUnorm8. `perturbedRenders` says how many of the
-// variants are the exchangeable perturbed renders (K). `orderMask` (any non-zero R, G or B) may be null.
+// variants are the exchangeable perturbed renders (K). `orderMask` (any non-zero R, G or B) may be null. `objects`
+// (the nominal's primary-ray objects) may be null: the image is then one object. The leave-one-out flags of the
+// regional test are made where K <= kMaxRegionalRenders.
 Envelope makeEnvelope(const Image& nominal, const std::vector<const Image*>& variants, uint32_t perturbedRenders,
-                      const Image* orderMask);
+                      const Image* orderMask, const ObjectMap* objects = nullptr);
 
 // One OpenEXR file, 32-bit float channels R G B A (nominal), lo.R lo.G lo.B hi.R hi.G hi.B (code/255), class
-// (0 stable, 1 sensitive), order (0/1), provenance as refray:* string attributes (docs/golden-format.md).
+// (0 stable, 1 sensitive), order (0/1), object (the object id) and loo.stableUp, loo.stableDown,
+// loo.sensitiveAbove, loo.sensitiveBelow (bit masks of the perturbed renders), provenance as refray:* string
+// attributes (docs/golden-format.md).
 // Throws refray::Error naming the path.
 void writeEnvelope(const std::string& path, const Envelope& envelope);
 // Throws refray::Error naming the path for a missing file, a file that is no envelope (no lo.R channel: "a plain
-// image"), another envelope format, or corrupted values (lo > hi, the nominal outside its bounds, class not 0/1).
+// image"), another envelope format (refray-envelope/1 loads, without the regional data), or corrupted values (lo >
+// hi, the nominal outside its bounds, class not 0/1, a flag mask with bits past K).
 Envelope readEnvelope(const std::string& path);
 // Whether the file is an envelope (has the lo.R channel); false for a plain image. Throws when unreadable.
 bool isEnvelopeFile(const std::string& path);
@@ -99,8 +113,9 @@ struct EnvelopeJudgement {
     double expectedStableOutside = 0;  // mean(c_i): the stable pixels a correct candidate moves, by leave-one-out
     uint64_t stableBudget = 0;      // the most stable pixels a correct candidate moves (stableBudget below)
     int maxSteps = 0;
+    RegionalJudgement regional;  // the regional count test; the verdict fails where it fails
     std::vector<EnvelopePixel> outside;  // every pixel outside its allowance, in scan order (order pixels included)
-    Image heatMap;                       // see docs/compare.md, "Envelope goldens"
+    Image heatMap;  // see docs/compare.md, "Envelope goldens"; failing regions outlined in cyan
     std::string describe(size_t listed = 10) const;
 };
 

@@ -480,6 +480,13 @@ int runGoldenSet(const CompareCommandOptions& o) {
                         (unsigned long long)r.judgement.stableOutside, (unsigned long long)r.judgement.stableBudget,
                         (unsigned long long)r.judgement.sensitiveOutside,
                         (unsigned long long)r.judgement.sensitiveBudget, (unsigned long long)r.judgement.nonFinite);
+        if (r.problem.empty() && r.verdict() != CompareVerdict::Mismatch) {
+            // The regional count test: the failing region, or how close the closest came.
+            const RegionalJudgement& regional = r.judgement.regional;
+            if (!regional.available) std::printf(", regional test not judged (an older envelope)");
+            else if (regional.failed()) std::printf(", regional: %s", regional.failing.front().describe().c_str());
+            else std::printf(", regional p %.2g", regional.smallestAdjustedP);
+        }
         std::printf("\n");
     }
     for (const SetRow& r : rows)

@@ -166,6 +166,8 @@ int runDiscriminate(const GoldenCommandOptions& o) {
             std::printf(" stable %llu/%llu  sensitive %llu/%llu  %.1f s", (unsigned long long)r.judgement.stableOutside,
                         (unsigned long long)r.judgement.stableBudget, (unsigned long long)r.judgement.sensitiveOutside,
                         (unsigned long long)r.judgement.sensitiveBudget, r.seconds);
+        if (r.ran && r.judgement.regional.available)
+            std::printf("  regional p %.2g", r.judgement.regional.smallestAdjustedP);
         else
             std::printf(" %s", r.error.c_str());
         if (!r.note.empty()) std::printf("  (%s)", r.note.c_str());

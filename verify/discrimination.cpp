@@ -73,6 +73,9 @@ std::vector<DiscriminationCandidate> makeCandidates() {
     // Mutants: scene data a back end uploads wrong (patches of the scene file).
     c.push_back({"diffuse-2pc", K::Mutant, "every material's diffuse coefficient 2 % low", "scene: diffuseCoef x 0.98"});
     c.push_back({"specular-3pc", K::Mutant, "every material's specular coefficient 3 % high", "scene: specularCoef x 1.03"});
+    c.push_back({"specular-power-one-material", K::Mutant,
+                 "one material's specular power one higher (the lowest one: D3D12's cog 2 -> 3)",
+                 "scene: the first material of the lowest specularPower, specularPower + 1"});
     c.push_back({"albedo-1pc", K::Mutant, "every material's albedo 1 % low", "scene: albedo.rgb x 0.99"});
     c.push_back({"reflectance-3pc", K::Mutant, "every material's reflectance 3 % low", "scene: reflectanceCoef x 0.97"});
     c.push_back({"ambient-2pc", K::Mutant, "the ambient light 2 % low", "scene: light.ambientColor.rgb x 0.98"});
@@ -141,6 +144,19 @@ std::string scenePatch(const json::Value& scene, const std::string& name) {
     else if (name == "specular-3pc") scaleMaterials("specularCoef", 1.03, false);
     else if (name == "albedo-1pc") scaleMaterials("albedo", 0.99, true);
     else if (name == "reflectance-3pc") scaleMaterials("reflectanceCoef", 0.97, false);
+    else if (name == "specular-power-one-material") {
+        const json::Value* values = scene.find("values");
+        REFRAY_CHECK(values && values->isObject(), "the scene has no 'values' to patch");
+        std::string lowest;
+        double power = 0;
+        for (const auto& member : values->asObject())
+            if (const json::Value* v = member.value.find("specularPower"); v && (lowest.empty() || v->asNumber() < power)) {
+                lowest = member.key;
+                power = v->asNumber();
+            }
+        REFRAY_CHECK(!lowest.empty(), "the scene has no material with a specularPower to patch");
+        replace("/values/" + lowest + "/specularPower", number(power + 1));
+    }
     else if (name == "ambient-2pc" || name == "light-y-flipped") {
         const json::Value* light = scene.find("light");
         REFRAY_CHECK(light, "the scene has no 'light' to patch");
@@ -380,15 +396,33 @@ bool outcomeAsExpected(const DiscriminationRow& row) {
 
 namespace {
 
+std::string pValue(double p) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.2g", p);
+    return buf;
+}
+
 // Why a mutant that passes cannot be caught by this golden (or by any image test).
 std::string missReason(const DiscriminationRow& r) {
     if (r.changedStable + r.changedSensitive + r.changedOrder == 0)
         return "changes no pixel by more than one step at this setting: invisible to any image test";
     const std::string sensitive = std::to_string(r.judgement.sensitiveOutside) + " sensitive pixels outside (budget " +
                                   std::to_string(r.judgement.sensitiveBudget) + ")";
-    if (r.changedStable == 0) return "moves no stable pixel, and " + sensitive + ": within what correct renders do";
+    const std::string regional = r.judgement.regional.available
+                                     ? "; no region and direction stands out (smallest adjusted p " +
+                                           pValue(r.judgement.regional.smallestAdjustedP) + ")"
+                                     : "";
+    if (r.changedStable == 0)
+        return "moves no stable pixel, and " + sensitive + ": within what correct renders do" + regional;
     return "moves " + std::to_string(r.changedStable) + " stable pixels, within the " +
-           std::to_string(r.judgement.stableBudget) + " that correct renders may move, and " + sensitive;
+           std::to_string(r.judgement.stableBudget) + " that correct renders may move, and " + sensitive + regional;
+}
+
+// Whether only the regional count test fails the row (the whole-image counts pass it).
+bool regionalOnly(const DiscriminationRow& r) {
+    const EnvelopeJudgement& j = r.judgement;
+    return r.ran && j.regional.failed() && j.nonFinite == 0 && j.stableOutside <= j.stableBudget &&
+           j.sensitiveOutside <= j.sensitiveBudget;
 }
 
 }  // namespace
@@ -402,14 +436,21 @@ std::string discriminationMarkdown(const std::vector<DiscriminationRow>& rows) {
         if (std::find(goldens.begin(), goldens.end(), r.golden) == goldens.end()) goldens.push_back(r.golden);
     }
     uint64_t correct = 0, falseAlarms = 0, mutants = 0, caught = 0, warned = 0, missed = 0, invisible = 0;
+    uint64_t caughtRegionally = 0;
+    const DiscriminationRow* closest = nullptr;  // the correct row of the smallest regional p
     for (const DiscriminationRow& r : rows) {
         if (r.candidate.kind == CandidateKind::Correct) {
             if (!r.ran) continue;
             ++correct;
             falseAlarms += r.judgement.verdict == CompareVerdict::Fail;
+            // The closest by the unadjusted p of its most extreme region (the adjusted one is 1 for most).
+            if (r.judgement.regional.available && r.judgement.regional.closest.candidate > 0 &&
+                (!closest || r.judgement.regional.closest.p < closest->judgement.regional.closest.p))
+                closest = &r;
             continue;
         }
         ++mutants;
+        caughtRegionally += regionalOnly(r);
         if (outcomeAsExpected(r)) ++caught;
         else if (r.changedStable + r.changedSensitive + r.changedOrder == 0) ++invisible;
         else if (r.judgement.verdict == CompareVerdict::Warn) ++warned;
@@ -419,9 +460,18 @@ std::string discriminationMarkdown(const std::vector<DiscriminationRow>& rows) {
     md << "| correct candidates | " << correct << " | " << falseAlarms << " false alarms |\n";
     md << "| mutants | " << mutants << " | " << caught << " caught, " << warned << " only warned, " << missed
        << " missed, " << invisible << " invisible (no pixel changed by more than one step) |\n\n";
+    md << "Of the catches, " << caughtRegionally
+       << " by the regional count test alone (the whole-image counts pass them)";
+    if (closest)
+        md << "; the correct judgement closest to failing it: `" << closest->candidate.name << "` on "
+           << closest->golden << ", p " << pValue(closest->judgement.regional.closest.p) << " over "
+           << closest->judgement.regional.tests << " tests, adjusted "
+           << pValue(closest->judgement.regional.smallestAdjustedP) << " (FAILURE below "
+           << pValue(closest->judgement.regional.falseAlarm) << ")";
+    md << ".\n\n";
 
-    md << "Each cell: the verdict, then stable pixels moved / the stable budget, and sensitive pixels outside / their "
-          "budget.\n\n| candidate | kind |";
+    md << "Each cell: the verdict, then stable pixels moved / the stable budget, sensitive pixels outside / their "
+          "budget, and the regional count test's smallest adjusted p (bold where it fails).\n\n| candidate | kind |";
     for (const std::string& g : goldens) md << " " << g << " |";
     md << "\n|---|---|";
     for (size_t i = 0; i < goldens.size(); ++i) md << "---|";
@@ -442,6 +492,10 @@ std::string discriminationMarkdown(const std::vector<DiscriminationRow>& rows) {
             if (r.ran)
                 md << " " << r.judgement.stableOutside << "/" << r.judgement.stableBudget << ", "
                    << r.judgement.sensitiveOutside << "/" << r.judgement.sensitiveBudget;
+            if (r.ran && r.judgement.regional.available) {
+                const std::string p = "p " + pValue(r.judgement.regional.smallestAdjustedP);
+                md << ", " << (r.judgement.regional.failed() ? "**" + p + "**" : p);
+            }
             md << " |";
         }
         md << "\n";

@@ -16,6 +16,7 @@
 #include "core/text_file.h"
 #include "emulator/validation.h"
 #include "scenes/scene_loader.h"
+#include "verify/object_map.h"
 
 namespace refray::scenes {
 
@@ -228,10 +229,14 @@ std::vector<EnvelopePart> envelopeParts(const GoldenEntry& entry, uint32_t threa
     RenderSettings s = base;
     s.precision = procedural::Precision::Double;
     parts.push_back({"double", s});
+    // The nominal's objects for the regional count test (verify/object_map.h).
+    parts.push_back({"objects", base});
     return parts;
 }
 
 Image renderEnvelopePart(Scene& scene, const EnvelopePart& part) {
+    if (part.name == "objects")
+        return objectMapImage(renderObjectMap(scene, part.settings), part.settings.width, part.settings.height);
     if (!part.settings.perturbation) return scene.render(part.settings).image;
     RenderSettings s = part.settings;
     const uint32_t seed = uint32_t(s.perturbation->seed);
@@ -302,7 +307,8 @@ Envelope assembleEnvelope(GoldenEntry& entry, const std::map<std::string, Image>
     std::vector<const Image*> pointers = perturbed;
     pointers.insert(pointers.end(), orders.begin(), orders.end());
     pointers.push_back(&render("double"));
-    Envelope envelope = makeEnvelope(nominal, pointers, entry.perturbedRenders, &mask);
+    const ObjectMap objects = objectMapOf(render("objects"));
+    Envelope envelope = makeEnvelope(nominal, pointers, entry.perturbedRenders, &mask, &objects);
     const double nominalSeconds = total("nominal"), orderSeconds = total("order-"),
                  perturbedSeconds = total("perturbed-"), doubleSeconds = total("double");
 
@@ -335,6 +341,12 @@ Envelope assembleEnvelope(GoldenEntry& entry, const std::map<std::string, Image>
     p["count_test_rule"] = "clusters of m = max(9, ceil(var(c_i)/mean(c_i))) pixels; m times the largest y with "
                            "P(Binomial(y + T, 1/(K+1)) >= y) > 1e-3, T = sum ceil(c_i/m); at least max(c_i); the "
                            "sensitive budget is also at least the binomial 1e-3 quantile of 2/(K+1); docs/compare.md";
+    p["regional_test_rule"] =
+        "per object (instance x geometry of the nominal's primary ray; misses one more) cut by tiles of W/40, W/20, "
+        "W/10 at offsets 0 and half a tile, and whole; per direction (stable up/down, sensitive above/below): the "
+        "candidate's flags against the K leave-one-out renders' (planes loo.*) in clusters of m (connected components, "
+        "tile dispersion), P(Binomial(Y + T, q) >= Y), q = h E_c / (h E_c + sum E_i), E = whole-image counts, E_c at "
+        "least mean E_i; Bonferroni over every region and direction, FAILURE below 1e-3; docs/compare.md";
     p["other_variants"] = "precision double; adversarial orders 1.." + std::to_string(entry.orders);
     p["render_seconds_nominal"] = fixed(nominalSeconds);
     p["render_seconds_perturbed"] = fixed(perturbedSeconds);
@@ -498,7 +510,7 @@ void runGoldenJob(const fs::path& goldenDirectory, const fs::path& repositoryRoo
     const auto p = std::find_if(parts.begin(), parts.end(), [&](const EnvelopePart& x) { return x.name == part; });
     REFRAY_CHECK(p != parts.end(), "golden '" << name << "' has no render '" << part << "' (it has nominal, order-1.."
                                               << entry->orders << ", perturbed-1.." << entry->perturbedRenders
-                                              << ", double)");
+                                              << ", double, objects)");
     Scene scene(loadSceneFile(repositoryRoot / entry->scene));
     REFRAY_CHECK(scene.desc().fileHash == entry->sceneSha256,
                  (repositoryRoot / entry->scene).string() << " changed since the plan was written (SHA-256 "

@@ -104,7 +104,8 @@ using SceneBuiltCallback = std::function<void(const Scene&)>;
 Envelope renderEnvelope(Scene& scene, GoldenEntry& entry, const EnvelopeRenderOptions& options);
 
 // The renders an envelope is made of, each independent of the others: "nominal", "order-1".."order-N" (adversarial
-// orders), "perturbed-1".."perturbed-K" and "double", with their settings.
+// orders), "perturbed-1".."perturbed-K", "double" and "objects" (the nominal's object map for the regional count
+// test, verify/object_map.h, as an image), with their settings.
 struct EnvelopePart {
     std::string name;
     RenderSettings settings;

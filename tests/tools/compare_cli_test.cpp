@@ -331,6 +331,36 @@ TEST(CompareCliEnvelope, NominalPassesAStablePixelTwoStepsOffWarnsAndTwentyEight
     EXPECT_TRUE(contains(r.output, "28 stable pixels moved, more than 27 allowed")) << r.output;
 }
 
+// The regional count test (docs/compare.md, "The regional count test"): nine stable pixels moved up in one 3x3 block
+// are within the whole-image budget of 27, but no render moved a pixel there, so the block fails the regional test;
+// the report, the --golden-set line and the HTML page name the region.
+TEST(CompareCliEnvelope, ConcentratedMovesFailTheRegionalTestNamingTheRegion) {
+    const std::string dir = envelopeDirectory("envelope-regional", "no/such/scene.json", "0");
+    Image bad = unorm(32, 24);
+    for (uint32_t y = 12; y < 15; ++y)
+        for (uint32_t x = 20; x < 23; ++x) bad.at(x, y).g += 3.0f / 255.0f;
+    const std::string badPath = write(dir + "/bad.png", bad);
+    CliRun r = compare("--golden " + dir + "/scene.cam.envelope.exr " + badPath + " -o " + dir + "/heat.png");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "9 (")) << r.output;
+    EXPECT_TRUE(contains(r.output, "stable pixels moved up, the image, ")) << r.output;
+    EXPECT_TRUE(contains(r.output, "the 8 legal renders: 0 0 0 0 0 0 0 0")) << r.output;
+    const Image heat = refray::readImage(dir + "/heat.png");
+    bool cyan = false;
+    for (const vec4& p : heat.pixels()) cyan = cyan || (p.r == 0.0f && p.g == 1.0f && p.b == 1.0f);
+    EXPECT_TRUE(cyan) << "the failing region is outlined in cyan on the heat map";
+
+    const std::string candidates = directory("envelope-regional-candidates");
+    write(candidates + "/scene.cam.png", bad);
+    r = compare("--golden-set " + dir + " " + candidates + " --html " + candidates + "/report.html");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "regional: stable pixels moved up, the image, ")) << r.output;
+    std::ifstream html(candidates + "/report.html");
+    std::stringstream page;
+    page << html.rdbuf();
+    EXPECT_TRUE(contains(page.str(), "stable pixels moved up, the image, ")) << "the HTML report names the region";
+}
+
 TEST(CompareCliEnvelope, AnOlderFormatDirectoryExits4NamingTheManifest) {
     const std::string dir = directory("envelope-old");
     std::ofstream(dir + "/goldens.json") << "{\"format\": \"refray-goldens/1\", \"goldens\": []}\n";

@@ -40,8 +40,9 @@ TEST(GoldenJobsCli, ParallelLinesCollectToTheInProcessGolden) {
     const fs::path jobs = dir / "jobs.txt";
     auto r = runRefray(kMake + " -o " + (dir / "distributed").string() + " --emit-jobs " + jobs.string());
     ASSERT_EQ(r.status, 0) << r.output;
-    EXPECT_TRUE(contains(r.output, "wrote 7 job lines")) << r.output;  // nominal, 2 orders, 3 perturbed, double
-    ASSERT_EQ(lineCount(jobs), 7u);
+    // nominal, 2 orders, 3 perturbed, double, objects
+    EXPECT_TRUE(contains(r.output, "wrote 8 job lines")) << r.output;
+    ASSERT_EQ(lineCount(jobs), 8u);
     r = runCommand("parallel -j 2 < " + jobs.string());
     ASSERT_EQ(r.status, 0) << r.output;
     r = runRefray("golden make --collect -o " + (dir / "distributed").string());
@@ -76,7 +77,7 @@ TEST(GoldenJobsCli, CollectNamesTheMissingRendersAndWritesNothing) {
     ASSERT_EQ(r.status, 0) << r.output;
     r = runRefray("golden make --collect -o " + dir.string());
     EXPECT_EQ(r.status, 2) << r.output;
-    EXPECT_TRUE(contains(r.output, "6 of the plan's renders are missing")) << r.output;
+    EXPECT_TRUE(contains(r.output, "7 of the plan's renders are missing")) << r.output;  // 8 parts, the nominal rendered
     EXPECT_TRUE(contains(r.output, "refray golden job DIR d3d12-procedural-geometry.default order-1")) << r.output;
     EXPECT_FALSE(fs::exists(dir / "goldens.json"));
 }
@@ -89,7 +90,7 @@ TEST(GoldenJobsCli, AJobOfAnUnknownPartOrWithoutAPlanIsRefused) {
     ASSERT_EQ(runRefray(kMake + " -o " + dir.string() + " --emit-jobs " + (dir / "jobs.txt").string()).status, 0);
     r = runRefray("golden job " + dir.string() + " d3d12-procedural-geometry.default perturbed-9");
     EXPECT_EQ(r.status, 2) << r.output;
-    EXPECT_TRUE(contains(r.output, "has no render 'perturbed-9' (it has nominal, order-1..2, perturbed-1..3, double)"))
+    EXPECT_TRUE(contains(r.output, "has no render 'perturbed-9' (it has nominal, order-1..2, perturbed-1..3, double, objects)"))
         << r.output;
     r = runRefray("golden job " + dir.string() + " no-such-golden nominal");
     EXPECT_EQ(r.status, 2) << r.output;

@@ -13,7 +13,9 @@
 #include "core/envelope.h"
 #include "scenes/knobs.h"
 #include "core/hash.h"
+#include "verify/discrimination.h"
 #include "verify/golden.h"
+#include "verify/object_map.h"
 #include "scenes/scene_loader.h"
 
 namespace refray::scenes {
@@ -118,6 +120,45 @@ TEST(EnvelopeGolden, JuliaWithHalfTheIterationsFails) {
     RenderSettings s = goldenSettings(golden, 2);
     applyKnobAssignment(s, "julia-iterations=100");
     expectJudgement(golden, envelopeOf(golden), scene.render(s).image, false, "julia-iterations-100");
+}
+
+// The regional count test (issue 27): one material's specular power 2 -> 3 in the D3D12 scene (the cog) moves fewer
+// stable pixels than a correct render does, so the whole-image counts pass it; all of them move down on one small
+// area of one object, which the regional test fails, naming the object and the tile.
+TEST(EnvelopeGolden, OneMaterialsSpecularPowerFailsInItsRegion) {
+    DiscriminationOptions o;
+    o.goldenDirectory = kGoldenDirectory;
+    o.repositoryRoot = REFRAY_SOURCE_DIR;
+    o.threads = 2;
+    o.only = {"specular-power-one-material"};
+    o.goldens = {"d3d12-procedural-geometry.default"};
+    const std::vector<DiscriminationRow> rows = runDiscrimination(o);
+    ASSERT_EQ(rows.size(), 1u);
+    const EnvelopeJudgement& j = rows[0].judgement;
+    ASSERT_TRUE(rows[0].ran) << rows[0].error;
+    EXPECT_LE(j.stableOutside, j.stableBudget);
+    EXPECT_LE(j.sensitiveOutside, j.sensitiveBudget);
+    ASSERT_TRUE(j.regional.available);
+    ASSERT_TRUE(j.regional.failed()) << j.describe();
+    EXPECT_EQ(j.verdict, CompareVerdict::Fail);
+    const RegionalFinding& f = j.regional.failing.front();
+    EXPECT_EQ(f.family, FlagFamily::StableDown) << f.describe();  // a higher specular power: a narrower, darker lobe
+    EXPECT_EQ(f.objectName.rfind("object '", 0), 0u) << f.describe();
+    EXPECT_GT(f.candidate, 0u);
+}
+
+// The envelope carries its nominal's object map (instance x geometry of each primary ray), the regions of the
+// regional count test.
+TEST(EnvelopeGolden, CarriesTheObjectMapOfItsNominal) {
+    const GoldenEntry golden = entryNamed("d3d12-procedural-geometry.default");
+    const Envelope envelope = envelopeOf(golden);
+    EXPECT_EQ(envelope.format, kEnvelopeFormat);
+    Scene scene(loadSceneFile(fs::path(REFRAY_SOURCE_DIR) / golden.scene));
+    const ObjectMap objects = renderObjectMap(scene, goldenSettings(golden, 2));
+    EXPECT_EQ(envelope.objects.ids, objects.ids);
+    EXPECT_EQ(envelope.objects.names, objects.names);
+    EXPECT_EQ(objects.names.at(-1), "the background");
+    EXPECT_GT(objects.names.size(), 3u);
 }
 
 std::string goldenName(const ::testing::TestParamInfo<GoldenEntry>& info) {
