@@ -9,18 +9,13 @@
 #include <sys/stat.h>
 
 #include "core/error.h"
+#include "core/os_error.h"
 
 namespace refray {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string reason(int error) {
-    std::string text = std::strerror(error);
-    if (!text.empty()) text[0] = char(std::tolower((unsigned char)text[0]));
-    return text;
-}
 
 std::string sizeText(uint64_t bytes) {
     if (bytes >= (uint64_t(1) << 30) && bytes % (uint64_t(1) << 30) == 0) return std::to_string(bytes >> 30) + " GiB";
@@ -33,7 +28,7 @@ std::string sizeText(uint64_t bytes) {
 void checkInputFile(const std::string& path, const std::string& what, uint64_t maxBytes) {
     struct stat s {};
     REFRAY_CHECK(!path.empty(), "cannot read " << what << ": the file name is empty");
-    REFRAY_CHECK(::stat(path.c_str(), &s) == 0, "cannot read " << what << " '" << path << "': " << reason(errno));
+    REFRAY_CHECK(::stat(path.c_str(), &s) == 0, "cannot read " << what << " '" << path << "': " << osReason(errno));
     const char* kind = S_ISDIR(s.st_mode)                        ? "a directory"
                        : S_ISCHR(s.st_mode) || S_ISBLK(s.st_mode) ? "a device"
                        : S_ISFIFO(s.st_mode)                      ? "a FIFO"
@@ -53,7 +48,7 @@ std::string readInputFile(const std::string& path, const std::string& what, uint
     };
     errno = 0;
     std::unique_ptr<std::FILE, FileCloser> file(std::fopen(path.c_str(), "rb"));
-    REFRAY_CHECK(file, "cannot read " << what << " '" << path << "': " << reason(errno));
+    REFRAY_CHECK(file, "cannot read " << what << " '" << path << "': " << osReason(errno));
     std::string text;
     char buffer[1 << 16];
     size_t count = 0;
@@ -63,7 +58,7 @@ std::string readInputFile(const std::string& path, const std::string& what, uint
         REFRAY_CHECK(text.size() <= maxBytes, "cannot read " << what << " '" << path << "': it grew past the "
                                                              << sizeText(maxBytes) << " refray reads");
     }
-    REFRAY_CHECK(!std::ferror(file.get()), "cannot read " << what << " '" << path << "': " << reason(errno));
+    REFRAY_CHECK(!std::ferror(file.get()), "cannot read " << what << " '" << path << "': " << osReason(errno));
     return text;
 }
 

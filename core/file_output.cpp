@@ -15,19 +15,13 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/os_error.h"
 
 namespace refray {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-// The OS's reason for `error`, as a phrase that reads inside a sentence ("no space left on device").
-std::string reason(int error) {
-    std::string text = std::strerror(error);
-    if (!text.empty()) text[0] = char(std::tolower((unsigned char)text[0]));
-    return text;
-}
 
 // ---- Temporary files in flight, for the signal handler ----------------------------------------------------------
 // Fixed slots of plain characters: the handler may only call async-signal-safe functions, so it can neither lock nor
@@ -115,7 +109,7 @@ void checkOutputPath(const std::string& path) {
             continue;
         }
         REFRAY_CHECK(!error, "cannot write '" << path << "': cannot inspect its folder '" << a.string()
-                                               << "': " << reason(error.value()));
+                                               << "': " << osReason(error.value()));
         REFRAY_CHECK(fs::is_directory(status),
                      "cannot write '" << path << "': '" << a.string() << "' is a file, not a folder"
                                       << (a == p.parent_path() ? std::string()
@@ -126,7 +120,7 @@ void checkOutputPath(const std::string& path) {
     std::error_code error;
     const fs::file_status status = fs::status(p, error);
     if (status.type() == fs::file_type::not_found || error.value() == ENOTDIR) return;
-    REFRAY_CHECK(!error, "cannot write '" << path << "': " << reason(error.value()));
+    REFRAY_CHECK(!error, "cannot write '" << path << "': " << osReason(error.value()));
     const std::string kind = notRegularFile(status);
     REFRAY_CHECK(kind.empty(), "cannot write '" << path << "': it is " << kind
                                                 << ", not a regular file; give an output file name");
@@ -140,28 +134,28 @@ void writeFileAtomically(const std::string& path, std::string_view bytes) {
     if (fs::is_symlink(fs::symlink_status(target, error))) {
         target = fs::weakly_canonical(target, error);
         REFRAY_CHECK(!error, "cannot write '" << path << "': cannot resolve the symbolic link: "
-                                               << reason(error.value()));
+                                               << osReason(error.value()));
         checkOutputPath(target.string());
     }
     const fs::path folder = target.parent_path();
     if (!folder.empty()) {
         fs::create_directories(folder, error);
         REFRAY_CHECK(!error, "cannot write '" << path << "': cannot create its folder '" << folder.string()
-                                               << "': " << reason(error.value()));
+                                               << "': " << osReason(error.value()));
     }
 
     const fs::path temporary = temporaryPathFor(target);
     const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     REFRAY_CHECK(fd >= 0, "cannot write '" << path << "': cannot create a file in '"
                                            << (folder.empty() ? std::string(".") : folder.string())
-                                           << "': " << reason(errno));
+                                           << "': " << osReason(errno));
     const int slot = registerTemporary(temporary.string());
     const auto fail = [&](const std::string& what, int code, bool open) {
         if (open) ::close(fd);
         ::unlink(temporary.c_str());
         unregisterTemporary(slot);
         std::error_code ignored;
-        throw Error("cannot write '" + path + "': " + what + reason(code) + "; " +
+        throw Error("cannot write '" + path + "': " + what + osReason(code) + "; " +
                     (fs::exists(target, ignored) ? "the file there is unchanged" : "nothing was written"));
     };
 
