@@ -82,33 +82,55 @@ Buffer uploadBuffer(const VulkanContext& context, const void* data, VkDeviceSize
 
 // Storage image.
 
-StorageImage::StorageImage(const VulkanContext& context, uint32_t width, uint32_t height)
-    : context_(context), width_(width), height_(height) {
+void imageBarrier(const VulkanFunctions& f, VkCommandBuffer commands, VkImage image, uint32_t levels,
+                  VkImageLayout from, VkImageLayout to, VkAccessFlags srcAccess, VkAccessFlags dstAccess) {
+    auto barrier = vkStruct<VkImageMemoryBarrier>(VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER);
+    barrier.srcAccessMask = srcAccess;
+    barrier.dstAccessMask = dstAccess;
+    barrier.oldLayout = from;
+    barrier.newLayout = to;
+    barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    barrier.image = image;
+    barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, levels, 0, 1};
+    f.vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0,
+                           nullptr, 0, nullptr, 1, &barrier);
+}
+
+void createDeviceImage2D(const VulkanContext& context, VkFormat format, uint32_t width, uint32_t height, uint32_t levels,
+                         VkImageUsageFlags usage, VkImage& image, VkDeviceMemory& memory, VkImageView& view) {
     const VulkanFunctions& f = context.vk();
     auto info = vkStruct<VkImageCreateInfo>(VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO);
     info.imageType = VK_IMAGE_TYPE_2D;
-    info.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+    info.format = format;
     info.extent = {width, height, 1};
-    info.mipLevels = 1;
+    info.mipLevels = levels;
     info.arrayLayers = 1;
     info.samples = VK_SAMPLE_COUNT_1_BIT;
     info.tiling = VK_IMAGE_TILING_OPTIMAL;
-    info.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    info.usage = usage;
     info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    REFRAY_VK(f.vkCreateImage(context.device(), &info, nullptr, &image_));
+    REFRAY_VK(f.vkCreateImage(context.device(), &info, nullptr, &image));
     VkMemoryRequirements requirements;
-    f.vkGetImageMemoryRequirements(context.device(), image_, &requirements);
+    f.vkGetImageMemoryRequirements(context.device(), image, &requirements);
     auto allocate = vkStruct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
     allocate.allocationSize = requirements.size;
     allocate.memoryTypeIndex = context.memoryType(requirements.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    REFRAY_VK(f.vkAllocateMemory(context.device(), &allocate, nullptr, &memory_));
-    REFRAY_VK(f.vkBindImageMemory(context.device(), image_, memory_, 0));
+    REFRAY_VK(f.vkAllocateMemory(context.device(), &allocate, nullptr, &memory));
+    REFRAY_VK(f.vkBindImageMemory(context.device(), image, memory, 0));
     auto viewInfo = vkStruct<VkImageViewCreateInfo>(VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO);
-    viewInfo.image = image_;
+    viewInfo.image = image;
     viewInfo.viewType = VK_IMAGE_VIEW_TYPE_2D;
-    viewInfo.format = info.format;
-    viewInfo.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    REFRAY_VK(f.vkCreateImageView(context.device(), &viewInfo, nullptr, &view_));
+    viewInfo.format = format;
+    viewInfo.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, levels, 0, 1};
+    REFRAY_VK(f.vkCreateImageView(context.device(), &viewInfo, nullptr, &view));
+}
+
+StorageImage::StorageImage(const VulkanContext& context, uint32_t width, uint32_t height)
+    : context_(context), width_(width), height_(height) {
+    createDeviceImage2D(context, VK_FORMAT_R32G32B32A32_SFLOAT, width, height, 1,
+                        VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                        image_, memory_, view_);
 }
 
 StorageImage::~StorageImage() {
@@ -119,21 +141,6 @@ StorageImage::~StorageImage() {
 }
 
 namespace {
-
-void imageBarrier(const VulkanFunctions& f, VkCommandBuffer commands, VkImage image, VkImageLayout from,
-                  VkImageLayout to, VkAccessFlags srcAccess, VkAccessFlags dstAccess) {
-    auto barrier = vkStruct<VkImageMemoryBarrier>(VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER);
-    barrier.srcAccessMask = srcAccess;
-    barrier.dstAccessMask = dstAccess;
-    barrier.oldLayout = from;
-    barrier.newLayout = to;
-    barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    barrier.image = image;
-    barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    f.vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0,
-                           nullptr, 0, nullptr, 1, &barrier);
-}
 
 VkBufferImageCopy wholeImage(uint32_t width, uint32_t height) {
     VkBufferImageCopy region{};
@@ -152,11 +159,11 @@ void StorageImage::upload(const Image& image) {
     std::memcpy(staging.mapped(), image.pixels().data(), bytes);
     const VulkanFunctions& f = context_.vk();
     context_.submitAndWait([&](VkCommandBuffer commands) {
-        imageBarrier(f, commands, image_, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
+        imageBarrier(f, commands, image_, 1, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
                      VK_ACCESS_TRANSFER_WRITE_BIT);
         const VkBufferImageCopy region = wholeImage(width_, height_);
         f.vkCmdCopyBufferToImage(commands, staging.handle(), image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-        imageBarrier(f, commands, image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
+        imageBarrier(f, commands, image_, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
                      VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     });
 }
@@ -168,11 +175,11 @@ void StorageImage::download(Image& image) const {
     Buffer staging(context_, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryLocation::Host);
     const VulkanFunctions& f = context_.vk();
     context_.submitAndWait([&](VkCommandBuffer commands) {
-        imageBarrier(f, commands, image_, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+        imageBarrier(f, commands, image_, 1, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                      VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT);
         const VkBufferImageCopy region = wholeImage(width_, height_);
         f.vkCmdCopyImageToBuffer(commands, image_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging.handle(), 1, &region);
-        imageBarrier(f, commands, image_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
+        imageBarrier(f, commands, image_, 1, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
                      VK_ACCESS_TRANSFER_READ_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     });
     std::memcpy(image.pixels().data(), staging.mapped(), bytes);

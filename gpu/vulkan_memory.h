@@ -51,6 +51,16 @@ inline constexpr VkBufferUsageFlags kEmulatorBufferUsage =
     VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
     VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
 
+// A layout transition of the first `levels` MIP levels of a colour image, ordered after every earlier command.
+void imageBarrier(const VulkanFunctions& f, VkCommandBuffer commands, VkImage image, uint32_t levels,
+                  VkImageLayout from, VkImageLayout to, VkAccessFlags srcAccess, VkAccessFlags dstAccess);
+
+// A device-local 2D image of `format`, `levels` MIP levels and `usage`, its memory bound, and a view of every level:
+// what the render target (StorageImage) and the sampled textures (gpu/vulkan_texture.h) are made of. The caller
+// destroys the three handles, also when a later step throws (each is set as soon as it exists).
+void createDeviceImage2D(const VulkanContext& context, VkFormat format, uint32_t width, uint32_t height, uint32_t levels,
+                         VkImageUsageFlags usage, VkImage& image, VkDeviceMemory& memory, VkImageView& view);
+
 // A 2D rgba32f storage image in layout GENERAL (the render target UAV, RWTexture2D<float4>).
 class StorageImage {
 public:

@@ -34,21 +34,6 @@ std::vector<Level> levelsOf(const dxr::Texture2D* texture, const std::string& wh
     return levels;
 }
 
-void barrier(const VulkanFunctions& f, VkCommandBuffer commands, VkImage image, uint32_t levels, VkImageLayout from,
-             VkImageLayout to, VkAccessFlags srcAccess, VkAccessFlags dstAccess) {
-    auto b = vkStruct<VkImageMemoryBarrier>(VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER);
-    b.srcAccessMask = srcAccess;
-    b.dstAccessMask = dstAccess;
-    b.oldLayout = from;
-    b.newLayout = to;
-    b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = image;
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, levels, 0, 1};
-    f.vkCmdPipelineBarrier(commands, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0,
-                           nullptr, 0, nullptr, 1, &b);
-}
-
 }  // namespace
 
 SampledTexture::SampledTexture(const VulkanContext& context, const dxr::Texture2D* texture, const std::string& what)
@@ -65,30 +50,8 @@ SampledTexture::SampledTexture(const VulkanContext& context, const dxr::Texture2
     mipLevels_ = uint32_t(levels.size());
 
     try {
-        auto info = vkStruct<VkImageCreateInfo>(VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO);
-        info.imageType = VK_IMAGE_TYPE_2D;
-        info.format = kTextureFormat;
-        info.extent = {levels[0].width, levels[0].height, 1};
-        info.mipLevels = mipLevels_;
-        info.arrayLayers = 1;
-        info.samples = VK_SAMPLE_COUNT_1_BIT;
-        info.tiling = VK_IMAGE_TILING_OPTIMAL;
-        info.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-        info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-        REFRAY_VK(f.vkCreateImage(context.device(), &info, nullptr, &image_));
-        VkMemoryRequirements requirements;
-        f.vkGetImageMemoryRequirements(context.device(), image_, &requirements);
-        auto allocate = vkStruct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
-        allocate.allocationSize = requirements.size;
-        allocate.memoryTypeIndex = context.memoryType(requirements.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-        REFRAY_VK(f.vkAllocateMemory(context.device(), &allocate, nullptr, &memory_));
-        REFRAY_VK(f.vkBindImageMemory(context.device(), image_, memory_, 0));
-        auto viewInfo = vkStruct<VkImageViewCreateInfo>(VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO);
-        viewInfo.image = image_;
-        viewInfo.viewType = VK_IMAGE_VIEW_TYPE_2D;
-        viewInfo.format = kTextureFormat;
-        viewInfo.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, mipLevels_, 0, 1};
-        REFRAY_VK(f.vkCreateImageView(context.device(), &viewInfo, nullptr, &view_));
+        createDeviceImage2D(context, kTextureFormat, levels[0].width, levels[0].height, mipLevels_,
+                            VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, image_, memory_, view_);
 
         // Every level through one staging buffer, one copy region per level.
         VkDeviceSize bytes = 0;
@@ -106,12 +69,13 @@ SampledTexture::SampledTexture(const VulkanContext& context, const dxr::Texture2
             std::memcpy(staging.mapped() + regions[m].bufferOffset, levels[m].texels.data(),
                         levels[m].texels.size() * sizeof(vec4));
         context.submitAndWait([&](VkCommandBuffer commands) {
-            barrier(f, commands, image_, mipLevels_, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
-                    VK_ACCESS_TRANSFER_WRITE_BIT);
+            imageBarrier(f, commands, image_, mipLevels_, VK_IMAGE_LAYOUT_UNDEFINED,
+                         VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT);
             f.vkCmdCopyBufferToImage(commands, staging.handle(), image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                                      uint32_t(regions.size()), regions.data());
-            barrier(f, commands, image_, mipLevels_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                    VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT);
+            imageBarrier(f, commands, image_, mipLevels_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+                         VK_ACCESS_SHADER_READ_BIT);
         });
     } catch (...) {
         release();  // a constructor that throws runs no destructor
