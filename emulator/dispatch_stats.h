@@ -61,6 +61,13 @@ struct DispatchStats {
     // the occlusion query (DispatchOptions::specialise).
     std::array<uint64_t, 3> raysPerGatherMode{};
 
+    // RayQuery (inline tracing): TraceRayInline calls, candidates Proceed() handed to the shader (it returned TRUE:
+    // non-opaque triangles and procedural primitives, each the shader decides on), and commits (by Proceed for
+    // opaque triangles, RQ-14, and by the shader). ACCEPT_FIRST_HIT_AND_END_SEARCH shows here (RQ-16).
+    uint64_t queriesTraced = 0;
+    uint64_t queryCandidates = 0;
+    uint64_t queryCommits = 0;
+
     // Rays per ray type and depth, sorted by key; a type appears once it traced a ray.
     std::vector<RayTypeCounts> raysPerType;
     // Invocations per export and stage, sorted by stage, then export name; only exports that ran.

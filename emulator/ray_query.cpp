@@ -134,6 +134,7 @@ void commit(RayQueryState& q, const QueryHit& hit, uint32_t status, std::string_
     q.committed = hit;
     q.status = status;
     q.rs.tCurrent = hit.t;
+    threadOf(q).stats.queryCommits++;
     if (q.rs.effectiveFlags & RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH) q.searchEnded = true;  // RQ-16
     ThreadState& ts = threadOf(q);
     if (observer(ts)) {
@@ -268,6 +269,7 @@ void RayQueryObject::TraceRayInline(GpuVirtualAddress as, uint32_t rayFlags, uin
     q.rs.instanceInclusionMask = mask & kInstanceInclusionMaskBits;  // RQ-10
     q.rs.tCurrent = ray.TMax;                                        // RQ-27
     ts.rayCounter++;
+    ts.stats.queriesTraced++;
 
     if (ts.dispatch->options.observer) {
         TraceEvent e = detail::queryEvent(q, TraceEvent::Kind::QueryInit);
@@ -303,6 +305,7 @@ bool RayQueryObject::Proceed() {
         q.proceeded = true;
         result = detail::advance(q);
         q.phase = result ? QueryPhase::Candidate : QueryPhase::Finished;
+        if (result) ts.stats.queryCandidates++;
     }
     if (detail::observer(ts)) {
         TraceEvent e = detail::queryEvent(q, TraceEvent::Kind::QueryProceed);

@@ -229,6 +229,7 @@ std::shared_ptr<const StateObject> StateObject::create(const StateObjectDesc& de
             if (e->stage == ShaderStage::Compute) so->computeShaders_[n] = e;
         }
     }
+    so->exports_ = shaders;
     std::vector<std::string> shaderNames;
     for (const auto& [n, e] : shaders) shaderNames.push_back(n);
 

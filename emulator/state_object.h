@@ -205,6 +205,9 @@ public:
     const ShaderExport* findComputeShader(const std::string& exportName) const;
     // Every compute export, by name.
     const std::map<std::string, const ShaderExport*>& computeShaders() const { return computeShaders_; }
+    // Every export of the state object's libraries (those its DXIL library subobjects export), by name: what
+    // `refray table` lists the RayQuery objects of (ShaderExport::rayQueryFlags).
+    const std::map<std::string, const ShaderExport*>& exports() const { return exports_; }
 
     // Decodes 32 identifier bytes: the entry, or nullptr when they are not an identifier
     // of this state object (the caller reports REC-8/REC-9). isNull is set for all zeros.
@@ -220,6 +223,7 @@ private:
     std::vector<ProgramEntry> entries_;
     std::map<std::string, uint32_t> byName_;
     std::map<std::string, const ShaderExport*> computeShaders_;
+    std::map<std::string, const ShaderExport*> exports_;
     std::vector<std::shared_ptr<const ShaderLibrary>> libraries_;  // keeps exports alive
 };
 

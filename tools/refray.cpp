@@ -80,6 +80,10 @@ void printStats(const scenes::RenderResult& r, const Size& size) {
     std::printf("  rays per traversal mode: %llu every candidate, %llu bounded by the nearest sure commit, %llu "
                 "occlusion query\n",
                 u(st.raysPerGatherMode[0]), u(st.raysPerGatherMode[1]), u(st.raysPerGatherMode[2]));
+    if (st.queriesTraced)
+        std::printf("  RayQuery: %llu queries (TraceRayInline), %llu candidates handed to the shader (Proceed() TRUE), "
+                    "%llu commits\n",
+                    u(st.queriesTraced), u(st.queryCandidates), u(st.queryCommits));
 
     // Exclusive time per stage.
     const double total = st.profiledSeconds();
@@ -114,6 +118,12 @@ std::string statsJson(const scenes::RenderResult& r, const std::string& scene, c
     w.member("wallSeconds", r.dispatch.seconds).member("raysTraced", st.raysTraced);
     w.member("raysPerSecond", r.dispatch.seconds > 0 ? double(st.raysTraced) / r.dispatch.seconds : 0.0);
     w.member("candidates", st.candidates);
+    w.key("rayQueries")
+        .beginObject(json::Writer::Layout::Inline)
+        .member("queries", st.queriesTraced)
+        .member("candidatesHandedToTheShader", st.queryCandidates)
+        .member("commits", st.queryCommits)
+        .endObject();
     w.key("raysPerTraversalMode")
         .beginObject(json::Writer::Layout::Inline)
         .member("all", st.raysPerGatherMode[0])
