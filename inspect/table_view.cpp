@@ -336,6 +336,14 @@ std::string TableFinding::format() const {
     return out;
 }
 
+std::string rayQueryDeclaration(uint32_t templateFlags) { return "RayQuery<" + rayFlagsToString(templateFlags) + ">"; }
+
+std::vector<std::string> RayQueryOwnerView::declarations() const {
+    std::vector<std::string> out;
+    for (uint32_t flags : templateFlags) out.push_back(rayQueryDeclaration(flags));
+    return out;
+}
+
 const ShaderTableView& TableView::table(const std::string& key) const {
     for (const ShaderTableView& t : tables)
         if (t.key == key) return t;
@@ -557,6 +565,37 @@ TableView buildTableView(Scene& scene, procedural::Precision precision) {
                                                     ") is reached by no instance, geometry and ray type");
 
     view.findings = std::move(findings).sorted();
+
+    // RayQuery owners (RQ-2): the exports that declare RayQuery objects and that the scene runs: imported by a hit
+    // group, a ray generation, miss or callable export of the state object, or the scene's compute shader. (The
+    // library may export more; nothing runs those.)
+    for (const auto& [name, e] : stateObject->exports()) {
+        if (e->rayQueryFlags.empty()) continue;
+        bool runs = name == desc.computeShader;
+        for (const ProgramEntry& entry : stateObject->entries())
+            runs = runs || entry.shader == e || entry.intersection == e || entry.anyHit == e || entry.closestHit == e;
+        if (!runs) continue;
+        RayQueryOwnerView owner;
+        owner.exportName = name;
+        owner.stage = std::string(toString(e->stage));
+        owner.templateFlags = e->rayQueryFlags;
+        owner.numThreads[0] = e->numThreads.x;
+        owner.numThreads[1] = e->numThreads.y;
+        owner.numThreads[2] = e->numThreads.z;
+        for (const ProgramEntry& entry : stateObject->entries())
+            if (entry.kind == ProgramEntry::Kind::HitGroup &&
+                (entry.intersection == e || entry.anyHit == e || entry.closestHit == e))
+                owner.hitGroups.push_back(entry.name);
+        view.rayQueryOwners.push_back(std::move(owner));
+    }
+    if (!desc.computeShader.empty()) {
+        const ShaderExport* cs = stateObject->findComputeShader(desc.computeShader);
+        REFRAY_CHECK(cs, "the state object has no compute shader '" << desc.computeShader << "'");
+        view.compute.shader = desc.computeShader;
+        view.compute.numThreads[0] = cs->numThreads.x;
+        view.compute.numThreads[1] = cs->numThreads.y;
+        view.compute.numThreads[2] = cs->numThreads.z;
+    }
     return view;
 }
 

@@ -177,6 +177,27 @@ struct ReachView {
     std::string equation() const;
 };
 
+// An export that declares RayQuery objects (RQ-2): their template ray flags, in the order the export declares them
+// (ShaderLibrary::declareRayQueries), and where the export runs.
+struct RayQueryOwnerView {
+    std::string exportName;
+    std::string stage;                    // "closesthit", "compute", ... (ShaderStage)
+    std::vector<uint32_t> templateFlags;  // one per RayQuery object
+    std::vector<std::string> hitGroups;   // the hit groups that import it (hit-group stages)
+    uint32_t numThreads[3] = {1, 1, 1};   // compute: [numthreads(x, y, z)]
+
+    // "RayQuery<FORCE_OPAQUE|ACCEPT_FIRST_HIT_AND_END_SEARCH|CULL_BACK_FACING_TRIANGLES>", one per object.
+    std::vector<std::string> declarations() const;
+};
+// "RayQuery<NAMES>" for template ray flags: the names of rayFlagsToString, "NONE" for none.
+std::string rayQueryDeclaration(uint32_t templateFlags);
+
+// How the scene renders when it is not DispatchRays: a compute dispatch (SceneDesc::computeShader).
+struct ComputeDispatchView {
+    std::string shader;                  // empty: the scene renders with DispatchRays
+    uint32_t numThreads[3] = {1, 1, 1};  // its [numthreads]
+};
+
 struct TableFinding {
     enum class Level : uint8_t { Error, Warning, Note };
     Level level = Level::Error;
@@ -199,6 +220,10 @@ struct TableView {
     std::vector<ShaderTableView> tables;
     std::vector<ReachView> reachability;  // instance, then geometry, then ray type
     std::vector<TableFinding> findings;   // errors, then warnings, then notes; each in the order found
+    // Every export of the state object that declares RayQuery objects, by export name.
+    std::vector<RayQueryOwnerView> rayQueryOwners;
+    // A compute scene: the shader Device::dispatch runs, one thread per pixel; none of the tables above is read.
+    ComputeDispatchView compute;
 
     const ShaderTableView& table(const std::string& key) const;  // throws refray::Error for an unknown key
     size_t count(TableFinding::Level level) const;

@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/json_writer.h"
 #include "core/strings.h"
+#include "emulator/types.h"
 #include "scenes/scene.h"
 #include "tools/cli_common.h"
 
@@ -251,13 +252,47 @@ void writeRecord(json::Writer& w, const scenes::RecordView& r) {
     w.endObject();
 }
 
+std::string numThreadsText(const uint32_t (&n)[3]) {
+    return "numthreads(" + std::to_string(n[0]) + ", " + std::to_string(n[1]) + ", " + std::to_string(n[2]) + ")";
+}
+
+// The line a compute scene's header gets: what renders it, and that the tables are not read.
+std::string computeDispatchText(const scenes::ComputeDispatchView& c) {
+    return "Renders with a compute dispatch: Dispatch of compute shader " + inQuotes(c.shader) + ", " +
+           numThreadsText(c.numThreads) +
+           ", one thread per pixel (Device::dispatch). The ray-tracing pipeline and the shader tables below are built "
+           "but not read by it: its rays are RayQuery objects.";
+}
+
 }  // namespace
 
 std::string formatTableText(const TableView& v) {
     std::string out;
     out += "Scene " + inQuotes(v.scene) + ": shader library " + inQuotes(v.shaderLibrary) + ", " + v.precision +
            " shaders, state object " + inQuotes(v.stateObject) + "\n";
-    out += "A ray's hit-group record: I = R + M*G + C, address = HitGroupTable.StartAddress + StrideInBytes * I (IDX-1)\n\n";
+    out += "A ray's hit-group record: I = R + M*G + C, address = HitGroupTable.StartAddress + StrideInBytes * I (IDX-1)\n";
+    if (!v.compute.shader.empty())
+        out += computeDispatchText(v.compute) + "\n";
+    out += '\n';
+    if (!v.rayQueryOwners.empty()) {
+        out += "RayQuery objects (RQ-2: the template ray flags each export declares; a query's flags are these | "
+               "TraceRayInline's RayFlags, RQ-3). Inline queries read no shader table: the shader that owns one "
+               "intersects its procedural candidates and commits its hits itself\n";
+        TextTable owners({"export", "stage", "RayQuery objects", "in the scene"});
+        for (const scenes::RayQueryOwnerView& o : v.rayQueryOwners) {
+            std::string runs;
+            if (o.exportName == v.compute.shader) runs = "the scene's compute dispatch, " + numThreadsText(o.numThreads);
+            for (const std::string& g : o.hitGroups) runs += (runs.empty() ? "hit group " : ", ") + inQuotes(g);
+            if (!v.compute.shader.empty() && !o.hitGroups.empty())
+                runs += " (in the pipeline; the compute dispatch runs no hit group)";
+            if (runs.empty()) runs = "-";
+            std::string declarations;
+            for (const std::string& d : o.declarations()) declarations += (declarations.empty() ? "" : ", ") + d;
+            owners.row({o.exportName, o.stage, declarations, runs});
+        }
+        owners.print(out);
+        out += '\n';
+    }
 
     out += "Ray types (R, M, miss index and InstanceInclusionMask are the TraceRay arguments of their shaders)\n";
     TextTable rayTypes({"#", "name", "payload", "R", "M", "miss index", "miss record", "InstanceInclusionMask"});
@@ -320,6 +355,44 @@ std::string formatTableJson(const TableView& v) {
     w.beginObject();
     w.member("scene", v.scene).member("shaderLibrary", v.shaderLibrary).member("precision", v.precision);
     w.member("stateObject", v.stateObject);
+    w.key("dispatch").beginObject();
+    if (v.compute.shader.empty()) {
+        w.member("kind", "DispatchRays");
+    } else {
+        w.member("kind", "compute");
+        w.member("computeShader", v.compute.shader);
+        w.key("numThreads").beginArray(json::Writer::Layout::Inline);
+        for (uint32_t n : v.compute.numThreads) w.value(n);
+        w.endArray();
+        w.member("shaderTablesRead", false);
+        w.member("text", computeDispatchText(v.compute));
+    }
+    w.endObject();
+    w.key("rayQueryOwners").beginArray();
+    for (const scenes::RayQueryOwnerView& o : v.rayQueryOwners) {
+        w.beginObject();
+        w.member("export", o.exportName).member("stage", o.stage);
+        w.key("rayQueries").beginArray();
+        for (size_t i = 0; i < o.templateFlags.size(); ++i) {
+            w.beginObject(json::Writer::Layout::Inline);
+            w.member("templateRayFlags", o.templateFlags[i]);
+            w.member("flagNames", dxr::rayFlagsToString(o.templateFlags[i]));
+            w.member("declaration", o.declarations()[i]);
+            w.endObject();
+        }
+        w.endArray();
+        w.key("hitGroups").beginArray(json::Writer::Layout::Inline);
+        for (const std::string& g : o.hitGroups) w.value(g);
+        w.endArray();
+        w.member("computeDispatch", o.exportName == v.compute.shader);
+        if (o.stage == "compute") {
+            w.key("numThreads").beginArray(json::Writer::Layout::Inline);
+            for (uint32_t n : o.numThreads) w.value(n);
+            w.endArray();
+        }
+        w.endObject();
+    }
+    w.endArray();
 
     w.key("rayTypes").beginArray();
     for (const scenes::RayTypeView& t : v.rayTypes) {

@@ -399,5 +399,68 @@ TEST(TableView, FindingsAreOrderedErrorsWarningsNotes) {
     EXPECT_EQ(view.count(Level::Note), 1u);
 }
 
+// ---- RayQuery owners (issue 26): which exports own RayQuery objects, and what renders a compute scene
+
+const std::string kInline = std::string(REFRAY_SOURCE_DIR) + "/scenes/d3d12-procedural-geometry-inline.json";
+const std::string kInlineAO = std::string(REFRAY_SOURCE_DIR) + "/scenes/inline-ambient-occlusion.json";
+
+const RayQueryOwnerView* ownerOf(const TableView& view, const std::string& exportName) {
+    for (const RayQueryOwnerView& o : view.rayQueryOwners)
+        if (o.exportName == exportName) return &o;
+    return nullptr;
+}
+
+TEST(TableView, RQ_2_TheInlineShadowClosestHitsOwnTheirQueries) {
+    auto scene = loadScene(kInline);
+    const TableView view = buildTableView(*scene, Precision::Float);
+    EXPECT_TRUE(view.compute.shader.empty());
+    // Only the exports the scene runs: the two inline-shadow closest hits (the AO compute shader is in the library
+    // but not the scene's compute shader; the sample's TraceRay closest hits own no query).
+    ASSERT_EQ(view.rayQueryOwners.size(), 2u);
+    const RayQueryOwnerView* aabb = ownerOf(view, "MyClosestHitShader_AABB_InlineShadow");
+    ASSERT_NE(aabb, nullptr);
+    EXPECT_EQ(aabb->stage, "closesthit");
+    EXPECT_EQ(aabb->declarations(),
+              std::vector<std::string>{"RayQuery<FORCE_OPAQUE|ACCEPT_FIRST_HIT_AND_END_SEARCH|CULL_BACK_FACING_TRIANGLES>"});
+    EXPECT_EQ(aabb->hitGroups, (std::vector<std::string>{"MyHitGroup_AABB_AnalyticPrimitive",
+                                                         "MyHitGroup_AABB_VolumetricPrimitive",
+                                                         "MyHitGroup_AABB_SignedDistancePrimitive"}));
+    const RayQueryOwnerView* triangle = ownerOf(view, "MyClosestHitShader_Triangle_InlineShadow");
+    ASSERT_NE(triangle, nullptr);
+    EXPECT_EQ(triangle->hitGroups, std::vector<std::string>{"MyHitGroup_Triangle"});
+    EXPECT_EQ(triangle->templateFlags, std::vector<uint32_t>{dxr::RAY_FLAG_CULL_BACK_FACING_TRIANGLES |
+                                                             dxr::RAY_FLAG_FORCE_OPAQUE |
+                                                             dxr::RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH});
+}
+
+TEST(TableView, ATraceRaySceneOwnsNoQueries) {
+    auto scene = loadScene(kD3D12);
+    const TableView view = buildTableView(*scene, Precision::Float);
+    EXPECT_TRUE(view.rayQueryOwners.empty());
+    EXPECT_TRUE(view.compute.shader.empty());
+}
+
+TEST(TableView, AComputeSceneNamesItsDispatchAndItsQueries) {
+    auto scene = loadScene(kInlineAO);
+    const TableView view = buildTableView(*scene, Precision::Float);
+    EXPECT_EQ(view.compute.shader, "InlineAmbientOcclusionCS");
+    EXPECT_EQ(std::vector<uint32_t>(view.compute.numThreads, view.compute.numThreads + 3),
+              (std::vector<uint32_t>{8, 8, 1}));
+    // The closest hits of the pipeline's hit groups own queries too, though the dispatch runs none of them.
+    EXPECT_EQ(view.rayQueryOwners.size(), 3u);
+    const RayQueryOwnerView* cs = ownerOf(view, "InlineAmbientOcclusionCS");
+    ASSERT_NE(cs, nullptr);
+    EXPECT_EQ(cs->stage, "compute");
+    EXPECT_TRUE(cs->hitGroups.empty());
+    EXPECT_EQ(cs->declarations(),
+              (std::vector<std::string>{"RayQuery<CULL_BACK_FACING_TRIANGLES>",
+                                        "RayQuery<FORCE_OPAQUE|ACCEPT_FIRST_HIT_AND_END_SEARCH|CULL_BACK_FACING_TRIANGLES>"}));
+}
+
+TEST(TableView, RayQueryDeclarationNamesTheFlags) {
+    EXPECT_EQ(rayQueryDeclaration(0), "RayQuery<NONE>");
+    EXPECT_EQ(rayQueryDeclaration(dxr::RAY_FLAG_SKIP_PROCEDURAL_PRIMITIVES), "RayQuery<SKIP_PROCEDURAL_PRIMITIVES>");
+}
+
 }  // namespace
 }  // namespace refray::scenes

@@ -218,3 +218,69 @@ TEST(TableCli, UnreadableSceneExitsTwo) {
     EXPECT_EQ(parse.status, 2) << parse.output;
     EXPECT_NE(parse.output.find("refray table: " + broken + ":1:"), std::string::npos) << parse.output;
 }
+
+// Issue 26: `refray table` says which shaders own RayQuery objects, with their template flags, and that a compute
+// scene's tables are not read.
+TEST(TableCli, TextNamesTheRayQueryOwnersAndTheComputeDispatch) {
+    const CliRun r = run("table " + std::string(REFRAY_SOURCE_DIR) + "/scenes/inline-ambient-occlusion.json");
+    ASSERT_EQ(r.status, 0) << r.output;
+    const std::string& out = r.output;
+    EXPECT_NE(out.find("Renders with a compute dispatch: Dispatch of compute shader 'InlineAmbientOcclusionCS', "
+                       "numthreads(8, 8, 1), one thread per pixel (Device::dispatch). The ray-tracing pipeline and the "
+                       "shader tables below are built but not read by it"),
+              std::string::npos)
+        << out;
+    EXPECT_NE(out.find("RayQuery objects (RQ-2"), std::string::npos) << out;
+    EXPECT_NE(lineWith(out, {"InlineAmbientOcclusionCS", "compute", "RayQuery<CULL_BACK_FACING_TRIANGLES>, "
+                             "RayQuery<FORCE_OPAQUE|ACCEPT_FIRST_HIT_AND_END_SEARCH|CULL_BACK_FACING_TRIANGLES>",
+                             "the scene's compute dispatch, numthreads(8, 8, 1)"}),
+              "")
+        << out;
+    EXPECT_NE(lineWith(out, {"MyClosestHitShader_Triangle_InlineShadow", "hit group 'MyHitGroup_Triangle' (in the "
+                             "pipeline; the compute dispatch runs no hit group)"}),
+              "")
+        << out;
+
+    const CliRun inlineShadows = run("table " + std::string(REFRAY_SOURCE_DIR) + "/scenes/d3d12-procedural-geometry-inline.json");
+    ASSERT_EQ(inlineShadows.status, 0) << inlineShadows.output;
+    EXPECT_EQ(inlineShadows.output.find("compute dispatch"), std::string::npos) << inlineShadows.output;
+    EXPECT_NE(lineWith(inlineShadows.output,
+                       {"MyClosestHitShader_Triangle_InlineShadow", "closesthit",
+                        "RayQuery<FORCE_OPAQUE|ACCEPT_FIRST_HIT_AND_END_SEARCH|CULL_BACK_FACING_TRIANGLES>",
+                        "hit group 'MyHitGroup_Triangle'"}),
+              "")
+        << inlineShadows.output;
+    // A scene without queries prints no such section.
+    EXPECT_EQ(run("table " + kProceduray).output.find("RayQuery"), std::string::npos);
+}
+
+TEST(TableCli, JsonNamesTheRayQueryOwnersAndTheComputeDispatch) {
+    const CliRun r = run("table " + std::string(REFRAY_SOURCE_DIR) + "/scenes/inline-ambient-occlusion.json --json");
+    ASSERT_EQ(r.status, 0) << r.output;
+    const refray::json::Value v = refray::json::parse(r.output, "table.json");
+    const refray::json::Value& dispatch = *v.find("dispatch");
+    EXPECT_EQ(dispatch.find("kind")->asString(), "compute");
+    EXPECT_EQ(dispatch.find("computeShader")->asString(), "InlineAmbientOcclusionCS");
+    EXPECT_EQ(dispatch.find("numThreads")->asArray()[0].asInt(), 8);
+    EXPECT_EQ(dispatch.find("numThreads")->asArray()[2].asInt(), 1);
+    EXPECT_FALSE(dispatch.find("shaderTablesRead")->asBool());
+    // The compute shader, then the inline-shadow closest hits that the (unread) pipeline's hit groups import.
+    const auto& owners = v.find("rayQueryOwners")->asArray();
+    ASSERT_EQ(owners.size(), 3u);
+    EXPECT_EQ(owners[1].find("export")->asString(), "MyClosestHitShader_AABB_InlineShadow");
+    EXPECT_FALSE(owners[1].find("computeDispatch")->asBool());
+    EXPECT_EQ(owners[1].find("hitGroups")->asArray().size(), 3u);
+    EXPECT_EQ(owners[0].find("export")->asString(), "InlineAmbientOcclusionCS");
+    EXPECT_TRUE(owners[0].find("computeDispatch")->asBool());
+    const auto& queries = owners[0].find("rayQueries")->asArray();
+    ASSERT_EQ(queries.size(), 2u);
+    EXPECT_EQ(queries[0].find("templateRayFlags")->asInt(), 0x10);
+    EXPECT_EQ(queries[1].find("flagNames")->asString(), "FORCE_OPAQUE|ACCEPT_FIRST_HIT_AND_END_SEARCH|CULL_BACK_FACING_TRIANGLES");
+    EXPECT_EQ(queries[1].find("declaration")->asString(),
+              "RayQuery<FORCE_OPAQUE|ACCEPT_FIRST_HIT_AND_END_SEARCH|CULL_BACK_FACING_TRIANGLES>");
+
+    const CliRun plain = run("table " + kProceduray + " --json");
+    const refray::json::Value p = refray::json::parse(plain.output, "table.json");
+    EXPECT_EQ(p.find("dispatch")->find("kind")->asString(), "DispatchRays");
+    EXPECT_TRUE(p.find("rayQueryOwners")->asArray().empty());
+}
