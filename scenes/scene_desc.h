@@ -180,6 +180,9 @@ struct LessonDesc {
     std::string renderCamera;
     std::string renderSize = "160x90";
     std::string expectRender;
+    // How the lesson's render compares with its base's (same settings), when it renders: "same-as-base" or
+    // "differs-from-base"; "" = by the table findings (none: the same image; some: a different one).
+    std::string expectImage;
 };
 
 // The scene's "effects" block: effects of the shaders the scene switches off (docs/scene-format.md, scenes/effects.h).

@@ -377,12 +377,67 @@ inline constexpr uint32_t kInlineShadowQueryFlags =
 // TracePrimaryInline's: the radiance rays' flags.
 inline constexpr uint32_t kInlinePrimaryQueryFlags = RAY_FLAG_CULL_BACK_FACING_TRIANGLES;
 
+// The inline-tracing shaders as written (scenes/inline/*.hlsl), and variants with one classic mistake or one GPU
+// back-end bug each: extra exports named <export>_<variant> (inlineVariantSuffix) that the lessons
+// (scenes/lessons/) and the discrimination mutants (verify/discrimination.cpp) select. AsWritten is the code the
+// HLSL ports; every other value changes only the line its comment names.
+enum class InlineVariant : uint8_t {
+    AsWritten,
+    // LESSON inline-procedural-never-intersected: the Proceed loop handles triangles only; procedural candidates
+    // are never intersected, so inline rays pass through the procedural geometry.
+    IgnoreProcedural,
+    // LESSON accept-first-hit-for-shadows: the shadow / occlusion query without RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH:
+    // it searches for the closest hit where any hit answers the question (same image, more candidates).
+    SearchAllHits,
+    // LESSON committed-getters-after-a-miss: the primary query asks which instance it hit (CommittedInstanceIndex)
+    // before asking whether it hit anything (CommittedStatus): RQ-29 on the first ray that misses.
+    ReadCommittedAfterMiss,
+    // MUTANT rq-commit-outside-range: the shader-side range check dropped: each procedural candidate is intersected
+    // over the whole ray line (-TMax, TMax) instead of [RayTMin, CommittedRayT], and the t found is committed
+    // unchecked (RQ-22).
+    NoRangeCheck,
+    // MUTANT rq-committed-t-is-tmax: a back end whose CommittedRayT() returns the ray's TMax after a commit: the
+    // shader's reads of it after its commits get TMax.
+    CommittedTIsTMax,
+};
+inline constexpr InlineVariant kInlineVariants[] = {InlineVariant::AsWritten,        InlineVariant::IgnoreProcedural,
+                                                    InlineVariant::SearchAllHits,    InlineVariant::ReadCommittedAfterMiss,
+                                                    InlineVariant::NoRangeCheck,     InlineVariant::CommittedTIsTMax};
+
+// "" for AsWritten, else "_IgnoreProcedural", ...: appended to the export's name.
+std::string inlineVariantSuffix(InlineVariant v) {
+    switch (v) {
+        case InlineVariant::AsWritten: return "";
+        case InlineVariant::IgnoreProcedural: return "_IgnoreProcedural";
+        case InlineVariant::SearchAllHits: return "_SearchAllHits";
+        case InlineVariant::ReadCommittedAfterMiss: return "_ReadCommittedAfterMiss";
+        case InlineVariant::NoRangeCheck: return "_NoRangeCheck";
+        case InlineVariant::CommittedTIsTMax: return "_CommittedTIsTMax";
+    }
+    return "_Unknown";
+}
+
+// The shadow / occlusion query's template flags: kInlineShadowQueryFlags, less ACCEPT_FIRST_HIT_AND_END_SEARCH for
+// SearchAllHits.
+constexpr uint32_t inlineShadowQueryFlags(InlineVariant v) {
+    return v == InlineVariant::SearchAllHits ? kInlineShadowQueryFlags & ~uint32_t(RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH)
+                                             : kInlineShadowQueryFlags;
+}
+
+// q.CommittedRayT() as the variant's back end returns it (CommittedTIsTMax: TMax once something is committed).
+float committedRayT(const RayQueryObject& q, float rayTMax, InlineVariant v) {
+    if (v == InlineVariant::CommittedTIsTMax && q.CommittedStatus() != COMMITTED_NOTHING) return rayTMax;
+    return q.CommittedRayT();
+}
+
 // IntersectCandidateProceduralPrimitive: the intersection shaders' code for the query's current procedural
 // candidate, with the query's extent: RayTMin() -> q.RayTMin(), RayTCurrent() -> q.CommittedRayT(), RayFlags() ->
 // q.RayFlags() (a closest hit's own intrinsics describe its own ray). Returns true with t and the world normal.
+// PORT: rayTMax and the variant are for the variants only (InlineVariant); AsWritten reads neither.
 template <typename T>
 bool IntersectCandidateProceduralPrimitive(const ShaderContext& ctx, const RayQueryObject& q, const Accuracy& accuracy,
-                                           T& thit, tvec3<T>& normal) {
+                                           T& thit, tvec3<T>& normal, float rayTMax = 0.0f,
+                                           InlineVariant variant = InlineVariant::AsWritten) {
     const InlinePrimitive primitive =
         ctx.loadStructured<InlinePrimitive>(kInlinePrimitivesRegister, 0, 0, q.CandidateGeometryIndex());
     const PrimitiveInstancePerFrameBuffer aabbAttribute = ctx.load<PrimitiveInstancePerFrameBuffer>(
@@ -392,10 +447,12 @@ bool IntersectCandidateProceduralPrimitive(const ShaderContext& ctx, const RayQu
         GetRayInAABBPrimitiveLocalSpace<T>(q.CandidateObjectRayOrigin(), q.CandidateObjectRayDirection(), aabbAttribute);
     const auto shader = IntersectionShader(primitive.intersectionShader);
     const T elapsedTime = shader == IntersectionShader::VolumetricPrimitive ? T(sceneCB(ctx).elapsedTime) : T(0);
-    const PrimitiveHit<T> test =
-        IntersectPrimitive<T>(shader, primitive.primitiveType, localRay,
-                              CurrentExtent<T>(q.RayTMin(), q.CommittedRayT(), q.RayFlags()), elapsedTime,
-                              T(primitive.stepScale), accuracy);
+    const math::RayExtent<T> extent =
+        variant == InlineVariant::NoRangeCheck
+            ? CurrentExtent<T>(-rayTMax, rayTMax, q.RayFlags())  // MUTANT: the whole line, not [RayTMin, CommittedRayT]
+            : CurrentExtent<T>(q.RayTMin(), committedRayT(q, rayTMax, variant), q.RayFlags());
+    const PrimitiveHit<T> test = IntersectPrimitive<T>(shader, primitive.primitiveType, localRay, extent, elapsedTime,
+                                                       T(primitive.stepScale), accuracy);
     if (!test.hit) return false;
     thit = test.thit;
     normal = NormalToWorld(q.CandidateObjectToWorld3x4(), aabbAttribute, test.normal);
@@ -404,22 +461,26 @@ bool IntersectCandidateProceduralPrimitive(const ShaderContext& ctx, const RayQu
 
 // TraceShadowRayAndReportIfHit, traced inline: procedural candidates are intersected here and committed; the ground
 // plane's triangles are opaque (FORCE_OPAQUE) and committed inside Proceed (RQ-14).
+// PORT: RayQuery<kInlineShadowQueryFlags> q; the object is made with the variant's template flags
+// (inlineShadowQueryFlags), which for AsWritten are kInlineShadowQueryFlags.
 template <typename T>
 bool TraceShadowRayInlineAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
                                         const Effects& effects, const Accuracy& accuracy, const tvec3<T>& origin,
-                                        const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
+                                        const tvec3<T>& direction, uint32_t currentRayRecursionDepth,
+                                        InlineVariant variant = InlineVariant::AsWritten) {
     if (currentRayRecursionDepth >= maxDepth) return false;
     if (!kShadowMachinery || !effects.traceShadowRays) return false;  // PORT: shadows switched off (procedural/effects.h)
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
-    RayQuery<kInlineShadowQueryFlags> q(ctx);
+    RayQueryObject q(ctx, inlineShadowQueryFlags(variant), RAYQUERY_FLAG_NONE);
     // PORT: TraceRayParameters::InstanceMask is the library's shadow-ray mask, as in the TraceRay version.
     q.TraceRayInline(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_NONE,
                      traceRay[RayType::Shadow].instanceInclusionMask, rayDesc);
     while (q.Proceed()) {
         if (q.CandidateType() == CANDIDATE_PROCEDURAL_PRIMITIVE) {
+            if (variant == InlineVariant::IgnoreProcedural) continue;  // LESSON: the candidate is never intersected
             T thit;
             tvec3<T> normal;
-            if (IntersectCandidateProceduralPrimitive<T>(ctx, q, accuracy, thit, normal))
+            if (IntersectCandidateProceduralPrimitive<T>(ctx, q, accuracy, thit, normal, rayDesc.TMax, variant))
                 q.CommitProceduralPrimitiveHit(float(thit));  // ACCEPT_FIRST_HIT_AND_END_SEARCH: Proceed returns FALSE
         }
     }
@@ -433,12 +494,12 @@ enum class ShadowTracing : uint8_t { TraceRay, Inline };
 template <typename T>
 bool TraceShadowRayTowardsLight(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
                                 const Effects& effects, const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth,
-                                ShadowTracing tracing, const Accuracy& accuracy) {
+                                ShadowTracing tracing, const Accuracy& accuracy, InlineVariant variant) {
     const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
     const tvec3<T> toLight = hlsl::normalize(tvec3<T>(vec3(g_sceneCB.lightPosition)) - hitPosition);
     if (tracing == ShadowTracing::Inline)
         return TraceShadowRayInlineAndReportIfHit(ctx, traceRay, maxDepth, effects, accuracy, hitPosition, toLight,
-                                                  recursionDepth);
+                                                  recursionDepth, variant);
     return TraceShadowRayAndReportIfHit(ctx, traceRay, maxDepth, effects, hitPosition, toLight, recursionDepth);
 }
 
@@ -477,7 +538,7 @@ void MyRaygenShader(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, con
 template <typename T>
 void MyClosestHitShader_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
                                  const Effects& effects, RayPayload& rayPayload, const BuiltInTriangleIntersectionAttributes&,
-                                 ShadowTracing tracing) {
+                                 ShadowTracing tracing, InlineVariant variant) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
@@ -498,7 +559,7 @@ void MyClosestHitShader_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& 
     const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
     const bool shadowRayHit =
         TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, effects, g_sceneCB, rayPayload.recursionDepth, tracing,
-                                      accuracy);
+                                      accuracy, variant);
 
     // Grid lines from the primary camera rays' footprint, even for secondary hits (I7, H4).
     const T checkers = AnalyticalCheckersTexture(
@@ -523,7 +584,7 @@ void MyClosestHitShader_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& 
 template <typename T>
 void MyClosestHitShader_AABB(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
                              const Effects& effects, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr,
-                             ShadowTracing tracing) {
+                             ShadowTracing tracing, InlineVariant variant) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
@@ -532,7 +593,7 @@ void MyClosestHitShader_AABB(ShaderContext& ctx, const TraceRayArgumentSet& trac
     const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
     const bool shadowRayHit =
         TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, effects, g_sceneCB, rayPayload.recursionDepth, tracing,
-                                      accuracy);
+                                      accuracy, variant);
 
     tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
@@ -586,7 +647,8 @@ tvec3<T> CosineHemisphereDirection(const tvec3<T>& n, T u1, T u2) {
 // keeps no attributes of a procedural hit (RQ-23): the shader keeps the normal of the hit it commits.
 template <typename T>
 bool TracePrimaryInline(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                        const tvec3<T>& origin, const tvec3<T>& direction, tvec3<T>& hitPosition, tvec3<T>& normal) {
+                        const tvec3<T>& origin, const tvec3<T>& direction, tvec3<T>& hitPosition, tvec3<T>& normal,
+                        InlineVariant variant = InlineVariant::AsWritten) {
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     tvec3<T> committedNormal(T(0));
     RayQuery<kInlinePrimaryQueryFlags> q(ctx);
@@ -594,9 +656,11 @@ bool TracePrimaryInline(ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
                      traceRay[RayType::Radiance].instanceInclusionMask, rayDesc);
     while (q.Proceed()) {
         if (q.CandidateType() == CANDIDATE_PROCEDURAL_PRIMITIVE) {
+            if (variant == InlineVariant::IgnoreProcedural) continue;  // LESSON: the candidate is never intersected
             T thit;
             tvec3<T> candidateNormal;
-            if (IntersectCandidateProceduralPrimitive<T>(ctx, q, accuracy, thit, candidateNormal)) {
+            if (IntersectCandidateProceduralPrimitive<T>(ctx, q, accuracy, thit, candidateNormal, rayDesc.TMax,
+                                                         variant)) {
                 q.CommitProceduralPrimitiveHit(float(thit));
                 committedNormal = tvec3<T>(vec3(candidateNormal));  // float, as the HLSL's attribute
             }
@@ -606,9 +670,11 @@ bool TracePrimaryInline(ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
     }
     hitPosition = tvec3<T>(T(0));
     normal = tvec3<T>(T(0));
-    const uint32_t status = q.CommittedStatus();
+    uint32_t status = q.CommittedStatus();
+    if (variant == InlineVariant::ReadCommittedAfterMiss)  // LESSON: the instance (0: the ground) before the status
+        status = q.CommittedInstanceIndex() == 0 ? COMMITTED_TRIANGLE_HIT : status;
     if (status == COMMITTED_NOTHING) return false;
-    hitPosition = origin + T(q.CommittedRayT()) * direction;
+    hitPosition = origin + T(committedRayT(q, rayDesc.TMax, variant)) * direction;
     if (status == COMMITTED_TRIANGLE_HIT) {
         // MyClosestHitShader_Triangle's normal: the first vertex's, untransformed.
         const uint32_t baseIndex = q.CommittedPrimitiveIndex() * 6;
@@ -624,18 +690,21 @@ bool TracePrimaryInline(ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
 }
 
 // True when the occlusion ray meets any surface within AO_RADIUS.
+// PORT: RayQuery<kInlineShadowQueryFlags> q, as in TraceShadowRayInlineAndReportIfHit.
 template <typename T>
 bool TraceOcclusionInline(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                          const tvec3<T>& origin, const tvec3<T>& direction) {
+                          const tvec3<T>& origin, const tvec3<T>& direction,
+                          InlineVariant variant = InlineVariant::AsWritten) {
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), AO_RADIUS};
-    RayQuery<kInlineShadowQueryFlags> q(ctx);
+    RayQueryObject q(ctx, inlineShadowQueryFlags(variant), RAYQUERY_FLAG_NONE);
     q.TraceRayInline(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_NONE,
                      traceRay[RayType::Shadow].instanceInclusionMask, rayDesc);
     while (q.Proceed()) {
         if (q.CandidateType() == CANDIDATE_PROCEDURAL_PRIMITIVE) {
+            if (variant == InlineVariant::IgnoreProcedural) continue;  // LESSON: the candidate is never intersected
             T thit;
             tvec3<T> normal;
-            if (IntersectCandidateProceduralPrimitive<T>(ctx, q, accuracy, thit, normal))
+            if (IntersectCandidateProceduralPrimitive<T>(ctx, q, accuracy, thit, normal, rayDesc.TMax, variant))
                 q.CommitProceduralPrimitiveHit(float(thit));
         }
     }
@@ -644,7 +713,8 @@ bool TraceOcclusionInline(ShaderContext& ctx, const TraceRayArgumentSet& traceRa
 
 // [numthreads(8, 8, 1)] InlineAmbientOcclusionCS: one thread per pixel; threads past the render target's edge return.
 template <typename T>
-void InlineAmbientOcclusionCS(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy) {
+void InlineAmbientOcclusionCS(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                              InlineVariant variant) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const uvec3 id = ctx.DispatchThreadID();
     Image& target = ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView));
@@ -657,14 +727,15 @@ void InlineAmbientOcclusionCS(ShaderContext& ctx, const TraceRayArgumentSet& tra
                       g_sceneCB.projectionToWorld, origin, rayDir);
     tvec3<T> hitPosition, normal;
     tvec4<T> color = tvec4<T>(BackgroundColor);
-    if (TracePrimaryInline<T>(ctx, traceRay, accuracy, origin, rayDir, hitPosition, normal)) {
+    if (TracePrimaryInline<T>(ctx, traceRay, accuracy, origin, rayDir, hitPosition, normal, variant)) {
         const uint32_t seed = Hash(id.x ^ Hash(id.y));
         uint32_t escaped = 0;
         for (uint32_t i = 0; i < AO_RAY_COUNT; ++i) {
             const T u1 = T(UnitFloat(Hash(seed ^ (2 * i))));
             const T u2 = T(UnitFloat(Hash(seed ^ (2 * i + 1))));
             const tvec3<T> direction = CosineHemisphereDirection(normal, u1, u2);
-            if (!TraceOcclusionInline<T>(ctx, traceRay, accuracy, hitPosition + T(AO_ORIGIN_OFFSET) * normal, direction))
+            if (!TraceOcclusionInline<T>(ctx, traceRay, accuracy, hitPosition + T(AO_ORIGIN_OFFSET) * normal, direction,
+                                         variant))
                 escaped++;
         }
         const T ao = T(escaped) / T(AO_RAY_COUNT);
@@ -706,21 +777,49 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
             "MyClosestHitShader_Triangle" + suffix,
             in([traceRay, accuracy, effects, tracing](ShaderContext& ctx, RayPayload& payload,
                                                       const BuiltInTriangleIntersectionAttributes& attr) {
-                MyClosestHitShader_Triangle<T>(ctx, traceRay, accuracy, effects, payload, attr, tracing);
+                MyClosestHitShader_Triangle<T>(ctx, traceRay, accuracy, effects, payload, attr, tracing,
+                                               InlineVariant::AsWritten);
             }));
         lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
             "MyClosestHitShader_AABB" + suffix,
             in([traceRay, accuracy, effects, tracing](ShaderContext& ctx, RayPayload& payload,
                                                       const ProceduralPrimitiveAttributes& attr) {
-                MyClosestHitShader_AABB<T>(ctx, traceRay, accuracy, effects, payload, attr, tracing);
+                MyClosestHitShader_AABB<T>(ctx, traceRay, accuracy, effects, payload, attr, tracing,
+                                           InlineVariant::AsWritten);
             }));
     }
     lib.declareRayQueries("MyClosestHitShader_Triangle_InlineShadow", {kInlineShadowQueryFlags});
     lib.declareRayQueries("MyClosestHitShader_AABB_InlineShadow", {kInlineShadowQueryFlags});
     lib.addCompute("InlineAmbientOcclusionCS", uvec3(8, 8, 1), in([traceRay, accuracy](ShaderContext& ctx) {
-                       InlineAmbientOcclusionCS<T>(ctx, traceRay, accuracy);
+                       InlineAmbientOcclusionCS<T>(ctx, traceRay, accuracy, InlineVariant::AsWritten);
                    }));
     lib.declareRayQueries("InlineAmbientOcclusionCS", {kInlinePrimaryQueryFlags, kInlineShadowQueryFlags});
+    // The variants of the inline-tracing exports (InlineVariant): <export>_<variant>, for the lessons and mutants.
+    for (const InlineVariant variant : kInlineVariants) {
+        if (variant == InlineVariant::AsWritten) continue;
+        const std::string suffix = "_InlineShadow" + inlineVariantSuffix(variant);
+        lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
+            "MyClosestHitShader_Triangle" + suffix,
+            in([traceRay, accuracy, effects, variant](ShaderContext& ctx, RayPayload& payload,
+                                                      const BuiltInTriangleIntersectionAttributes& attr) {
+                MyClosestHitShader_Triangle<T>(ctx, traceRay, accuracy, effects, payload, attr, ShadowTracing::Inline,
+                                               variant);
+            }));
+        lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
+            "MyClosestHitShader_AABB" + suffix,
+            in([traceRay, accuracy, effects, variant](ShaderContext& ctx, RayPayload& payload,
+                                                      const ProceduralPrimitiveAttributes& attr) {
+                MyClosestHitShader_AABB<T>(ctx, traceRay, accuracy, effects, payload, attr, ShadowTracing::Inline,
+                                           variant);
+            }));
+        lib.declareRayQueries("MyClosestHitShader_Triangle" + suffix, {inlineShadowQueryFlags(variant)});
+        lib.declareRayQueries("MyClosestHitShader_AABB" + suffix, {inlineShadowQueryFlags(variant)});
+        const std::string cs = "InlineAmbientOcclusionCS" + inlineVariantSuffix(variant);
+        lib.addCompute(cs, uvec3(8, 8, 1), in([traceRay, accuracy, variant](ShaderContext& ctx) {
+                           InlineAmbientOcclusionCS<T>(ctx, traceRay, accuracy, variant);
+                       }));
+        lib.declareRayQueries(cs, {kInlinePrimaryQueryFlags, inlineShadowQueryFlags(variant)});
+    }
     lib.addMiss<RayPayload>("MyMissShader", MyMissShader);
     lib.addMiss<ShadowRayPayload>("MyMissShader_ShadowRay", MyMissShader_ShadowRay);
     // Each intersection shader's ReportHit is its last action, as in the HLSL: ReportHitEnd::Return spares the unwind

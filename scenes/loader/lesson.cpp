@@ -48,6 +48,11 @@ Value resolveLesson(Value root, const std::string& fileName, uint32_t depth, std
                 if (const Value* c = rr.optional("camera")) lesson.renderCamera = c->asString();
                 if (const Value* z = rr.optional("size")) lesson.renderSize = z->asString();
                 lesson.expectRender = rr.required("diagnostic").asString();
+                if (const Value* i = rr.optional("image")) {
+                    if (!i->isString() || (i->asString() != "same-as-base" && i->asString() != "differs-from-base"))
+                        i->fail("the lesson's expected image is \"same-as-base\" or \"differs-from-base\"");
+                    lesson.expectImage = i->asString();
+                }
                 rr.finish();
             }
             er.finish();

@@ -118,5 +118,32 @@ TEST(IndexMap, ADeviceReportedRecordIsTheValueAndItsLabelSaysSo) {
     EXPECT_EQ(other.legend[2].label, "record 3: HitGroup_Julia_Shadow (reported; R + M*G + C = 0 + 2*0 + 2 = 2)");
 }
 
+// RQ-31, dxr-semantics.md 18e: Vulkan's rayQueryGetIntersectionInstanceIdEXT is DXR's InstanceIndex, and
+// ...InstanceCustomIndexEXT DXR's InstanceID; a port that crosses them reads the wrong one. Neither inline scene's
+// shaders read either, so no image shows the mistake; the instance map of the compute scene (each thread's first
+// query's committed InstanceIndex) does, because the scene's InstanceIDs (0, 0) are not its InstanceIndices (0, 1):
+// a back end whose map reports InstanceID puts 0 on every pixel of the procedural primitives.
+TEST(IndexMap, RQ_31_AComputeScenesInstanceMapTellsInstanceIndexFromInstanceID) {
+    auto scene = loadScene(std::string(REFRAY_SOURCE_DIR) + "/scenes/inline-ambient-occlusion.json");
+    const RenderSettings s = small();
+    const std::vector<PrimaryHit> hits = renderPrimaryHits(*scene, s);
+    std::vector<PrimaryHit> crossed = hits;
+    uint64_t primitives = 0;
+    for (PrimaryHit& h : crossed) {
+        if (!h.hit) continue;
+        ASSERT_TRUE(h.instanceID.has_value());
+        primitives += h.instanceIndex == 1;
+        h.instanceIndex = *h.instanceID;  // what a crossed port reports as InstanceIndex
+    }
+    EXPECT_GT(primitives, 0u);
+    const IndexMap right = indexMapOf(scene->desc(), s.width, s.height, IndexMapKind::Instance, hits);
+    const IndexMap wrong = indexMapOf(scene->desc(), s.width, s.height, IndexMapKind::Instance, crossed);
+    EXPECT_EQ(right.values, renderIndexMap(*scene, s, IndexMapKind::Instance).values);
+    EXPECT_EQ(valuesOf(right), (std::set<int64_t>{-1, 0, 1}));
+    uint64_t differ = 0;
+    for (size_t i = 0; i < right.values.size(); ++i) differ += right.values[i] != wrong.values[i];
+    EXPECT_EQ(differ, primitives);
+}
+
 }  // namespace
 }  // namespace refray::scenes

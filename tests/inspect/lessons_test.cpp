@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "emulator/dispatch_stats.h"
 #include "emulator/validation.h"
 #include "scenes/scene.h"
 #include "scenes/scene_loader.h"
@@ -64,11 +65,14 @@ TEST_P(Lesson, ReportsExactlyWhatItPromises) {
 
     // Against the scene it breaks: a lesson without findings renders the same pixels; one with findings must
     // show its mistake, by a diagnostic or by a different image.
+    // A lesson may say which it is ("image"): a mistake no rule reports (inline rays that ignore procedural
+    // candidates) changes the image without findings, and a costlier but correct choice keeps it.
     if (!diagnostic.empty()) return;
     auto base = loadScene(std::filesystem::path(scene->desc().file).parent_path() / lesson.base);
     const Image reference = base->render(settings).image;
-    if (table.findings.empty())
-        EXPECT_EQ(image.pixels(), reference.pixels()) << "a lesson with nothing wrong must not change the image";
+    const bool same = lesson.expectImage.empty() ? table.findings.empty() : lesson.expectImage == "same-as-base";
+    if (same)
+        EXPECT_EQ(image.pixels(), reference.pixels()) << "the lesson promises the base's image";
     else
         EXPECT_NE(image.pixels(), reference.pixels()) << "the lesson's mistake does not show in the image";
 }
@@ -76,7 +80,9 @@ TEST_P(Lesson, ReportsExactlyWhatItPromises) {
 TEST_P(Lesson, TheTutorialQuotesIt) {
     auto scene = loadScene(kLessons / (GetParam() + ".json"));
     const LessonDesc& lesson = scene->desc().lesson;
-    const std::string tutorial = testing::readText(std::string(REFRAY_SOURCE_DIR) + "/docs/tutorial-indexing.md");
+    // The indexing lessons are in the indexing tutorial, the RayQuery lessons in docs/ray-query.md.
+    const std::string tutorial = testing::readText(std::string(REFRAY_SOURCE_DIR) + "/docs/tutorial-indexing.md") +
+                                 testing::readText(std::string(REFRAY_SOURCE_DIR) + "/docs/ray-query.md");
     EXPECT_CONTAINS(tutorial, "scenes/lessons/" + GetParam() + ".json");
     if (!lesson.expectTable.empty()) {
         EXPECT_CONTAINS(tutorial, lesson.expectTable);
@@ -92,6 +98,58 @@ INSTANTIATE_TEST_SUITE_P(Lessons, Lesson, ::testing::ValuesIn(lessonNames()),
                              std::replace(name.begin(), name.end(), '-', '_');
                              return name;
                          });
+
+// RQ-16, RQ-13: the shadow query without ACCEPT_FIRST_HIT_AND_END_SEARCH renders the same image
+// (ReportsExactlyWhatItPromises). In the default order (nearest first) a commit skips every farther box anyway; in
+// an adversarial order, as a GPU's unsorted traversal may be, the query without the flag is handed more candidates
+// and commits more hits. The same image there too.
+TEST(RayQueryLessons, RQ_16_AcceptFirstHitHandsTheShaderFewerCandidates) {
+    auto lesson = loadScene(kLessons / "accept-first-hit-for-shadows.json");
+    auto base = loadScene(kLessons / ".." / "d3d12-procedural-geometry-inline.json");
+    RenderSettings settings = lessonSettings(lesson->desc().lesson);
+    {
+        const dxr::DispatchStats with = base->render(settings).dispatch.stats;
+        const dxr::DispatchStats without = lesson->render(settings).dispatch.stats;
+        EXPECT_GT(with.queriesTraced, 0u);
+        EXPECT_EQ(with.queriesTraced, without.queriesTraced);
+        EXPECT_LE(with.queryCandidates, without.queryCandidates);
+        EXPECT_LE(with.queryCommits, without.queryCommits);
+    }
+    settings.order = dxr::TraversalOrder::Adversarial;
+    settings.adversarialSeed = 1;
+    const RenderResult with = base->render(settings);
+    const RenderResult without = lesson->render(settings);
+    EXPECT_EQ(with.image.pixels(), without.image.pixels());
+    EXPECT_EQ(with.dispatch.stats.queriesTraced, without.dispatch.stats.queriesTraced);
+    EXPECT_LT(with.dispatch.stats.queryCandidates, without.dispatch.stats.queryCandidates);
+    EXPECT_LT(with.dispatch.stats.queryCommits, without.dispatch.stats.queryCommits);
+    // The TraceRay part of the scene is untouched.
+    EXPECT_EQ(with.dispatch.stats.raysTraced - with.dispatch.stats.queriesTraced,
+              without.dispatch.stats.raysTraced - without.dispatch.stats.queriesTraced);
+}
+
+// RQ-22: a procedural candidate the shader does not intersect is never committed: the shadow queries of the
+// lesson commit only the ground plane's opaque triangles (inside Proceed, RQ-14), so fewer commits.
+TEST(RayQueryLessons, RQ_22_IgnoredProceduralCandidatesCommitNothing) {
+    auto lesson = loadScene(kLessons / "inline-procedural-never-intersected.json");
+    auto base = loadScene(kLessons / ".." / "d3d12-procedural-geometry-inline.json");
+    const RenderSettings settings = lessonSettings(lesson->desc().lesson);
+    const dxr::DispatchStats with = base->render(settings).dispatch.stats;
+    const dxr::DispatchStats without = lesson->render(settings).dispatch.stats;
+    EXPECT_EQ(with.queriesTraced, without.queriesTraced);
+    EXPECT_LT(without.queryCommits, with.queryCommits);
+}
+
+TEST(LessonFormat, AnExpectedImageIsSameOrDiffers) {
+    const std::string text = R"({"format": "refray-lesson/1", "name": "x", "base": "../proceduray-mandel-julia-pac.json",
+ "title": "t", "patch": [], "expect": {"render": {"diagnostic": "", "image": "similar"}}})";
+    try {
+        parseScene(text, (kLessons / "broken.json").string());
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_CONTAINS(e.what(), "the lesson's expected image is \"same-as-base\" or \"differs-from-base\"");
+    }
+}
 
 TEST(LessonFormat, PatchErrorsPointAtTheLesson) {
     const std::string text = R"({"format": "refray-lesson/1", "name": "x", "base": "../proceduray-mandel-julia-pac.json",
