@@ -142,6 +142,7 @@ int runDiscriminate(const GoldenCommandOptions& o) {
     options.repositoryRoot = o.repositoryRoot;
     options.threads = d.threads;
     options.only = d.only;
+    options.goldens = d.goldens;
     if (!d.fmaRefray.empty()) {
         REFRAY_CHECK(fs::exists(d.fmaRefray), "--fma-refray: no such file '" << d.fmaRefray << "'");
         options.fusedRefray = d.fmaRefray;
@@ -260,6 +261,8 @@ CLI::App* addGoldenCommand(CLI::App& app, GoldenCommandOptions& o) {
                              "refray built with fused multiply-add (the refray-fma target; default: refray-fma beside "
                              "this binary)");
     discriminate->add_option("--only", d.only, "Run only these candidates (names as the report prints them)")
+        ->delimiter(',');
+    discriminate->add_option("--golden", d.goldens, "Judge only these goldens of the set (names as goldens.json gives them)")
         ->delimiter(',');
     discriminate->add_option("--markdown", d.markdown, "Write the report's tables (Markdown) to FILE");
     discriminate->add_option("--threads", d.threads, "Worker threads (0: all)")->check(threadCount());

@@ -3,7 +3,7 @@
 //   update [--size] [--dir] [--emit-jobs FILE | --collect]   every deterministic scene x camera
 //   make SCENE [--camera --time --size] -o DIR [--emit-jobs FILE] | make --collect -o DIR
 //   job DIR NAME PART                                        one render of a plan (what --emit-jobs lines run)
-//   discriminate [DIR] [--only ...] [--markdown FILE]        correct candidates and mutants against a golden set
+//   discriminate [DIR] [--only ...] [--golden ...] [--markdown FILE]  correct candidates and mutants against a golden set
 //
 // Wiring into the main program (tools/refray.cpp):
 //     refray::tools::GoldenCommandOptions goldenOptions;
@@ -41,6 +41,7 @@ struct GoldenCommandOptions {
         std::string goldenDirectory = "tests/golden";
         std::string fmaRefray;  // empty: refray-fma beside this binary, if there is one
         std::vector<std::string> only;
+        std::vector<std::string> goldens;  // --golden: judge only these goldens
         std::string markdown;
         uint32_t threads = 0;
     } discriminate;

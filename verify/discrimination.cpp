@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "core/json.h"
+#include "core/json_writer.h"
 #include "core/strings.h"
 #include "scenes/knobs.h"
 #include "scenes/scene.h"
@@ -94,6 +95,20 @@ std::vector<DiscriminationCandidate> makeCandidates() {
     c.push_back({"transform-transposed", K::Mutant,
                  "instance 1's 3x4 transform uploaded transposed: rotation inverted, translation lost",
                  "scene: instances[1].transform transposed"});
+    // Mutants: RayQuery bugs (issue 26), each played by variant exports of the inline-tracing shaders that the patch
+    // puts in the scene (procedural/d3d12/d3d12_shaders.cpp, InlineVariant). A scene without inline tracing keeps its
+    // exports: the mutant renders the nominal image there.
+    c.push_back({"rq-procedural-ignored", K::Mutant,
+                 "inline tracing that never intersects procedural candidates (a Proceed loop written for triangles, or a "
+                 "back end that drops CANDIDATE_PROCEDURAL_PRIMITIVE): procedural geometry invisible to RayQuery",
+                 "scene: inline-tracing exports -> their _IgnoreProcedural variants"});
+    c.push_back({"rq-commit-outside-range", K::Mutant,
+                 "the shader-side range check dropped: each procedural candidate intersected over the whole ray line and "
+                 "its t committed unchecked, outside [RayTMin, CommittedRayT] (RQ-22)",
+                 "scene: inline-tracing exports -> their _NoRangeCheck variants"});
+    c.push_back({"rq-committed-t-is-tmax", K::Mutant,
+                 "CommittedRayT() returns the ray's TMax after a commit (the wrong committed t read back)",
+                 "scene: inline-tracing exports -> their _CommittedTIsTMax variants"});
     // Mutants: the camera and the clock.
     c.push_back({"time-one-frame-late", K::Mutant, "the animation one 60 Hz frame late", "--time t + 1/60"});
     // Mutants: the output stage (the render is right, the image written is not).
@@ -140,7 +155,24 @@ std::string scenePatch(const json::Value& scene, const std::string& name) {
         ops.push_back("{\"op\": \"add\", \"path\": \"/rayTypes/" + std::to_string(rayType) + "/traceRay\", \"value\": " +
                       object + "}");
     };
-    if (name == "diffuse-2pc") scaleMaterials("diffuseCoef", 0.98, false);
+    // The inline-tracing exports (closest hits ending in _InlineShadow, the compute shader) -> their variants.
+    const auto inlineVariant = [&](const std::string& suffix) {
+        if (const json::Value* groups = scene.find("hitGroups"))
+            for (size_t i = 0; i < groups->asArray().size(); ++i)
+                if (const json::Value* ch = groups->asArray()[i].find("closestHit")) {
+                    const std::string& e = ch->asString();
+                    const std::string tail = "_InlineShadow";
+                    if (e.size() >= tail.size() && e.compare(e.size() - tail.size(), tail.size(), tail) == 0)
+                        replace("/hitGroups/" + std::to_string(i) + "/closestHit", json::quoted(e + suffix));
+                }
+        if (const json::Value* pipeline = scene.find("pipeline"))
+            if (const json::Value* cs = pipeline->find("compute"))
+                replace("/pipeline/compute", json::quoted(cs->asString() + suffix));
+    };
+    if (name == "rq-procedural-ignored") inlineVariant("_IgnoreProcedural");
+    else if (name == "rq-commit-outside-range") inlineVariant("_NoRangeCheck");
+    else if (name == "rq-committed-t-is-tmax") inlineVariant("_CommittedTIsTMax");
+    else if (name == "diffuse-2pc") scaleMaterials("diffuseCoef", 0.98, false);
     else if (name == "specular-3pc") scaleMaterials("specularCoef", 1.03, false);
     else if (name == "albedo-1pc") scaleMaterials("albedo", 0.99, true);
     else if (name == "reflectance-3pc") scaleMaterials("reflectanceCoef", 0.97, false);
