@@ -180,6 +180,39 @@ TEST(RayQuery, RQ_1_AQueryRunsFromEveryRayTracingStageAndFromCompute) {
     }
 }
 
+// A ray that accepts the first hit and skips the closest hit, in a pipeline without any-hit shaders, has its
+// candidates processed while Embree traverses (GatherMode::FirstHit): the intersection shader runs inside Embree's
+// callback, and its query traverses again from there.
+TEST(RayQuery, RQ_1_AQueryInAnIntersectionShaderRunsDuringAFirstHitTraversal) {
+    Rig r;
+    r.h.stateObject.hitGroups.erase(std::remove_if(r.h.stateObject.hitGroups.begin(), r.h.stateObject.hitGroups.end(),
+                                                   [](const HitGroupDesc& g) { return !g.AnyHitShaderImport.empty(); }),
+                                    r.h.stateObject.hitGroups.end());
+    const GpuVirtualAddress target =
+        r.h.tlas({Harness::instance(r.h.blas({r.h.triangles(trisAt({20, 10}), GEOMETRY_FLAG_NONE)}), 0,
+                                    Matrix3x4::identity(), 0xFF, INSTANCE_FLAG_NONE, 42)});
+    r.h.tlas({Harness::instance(r.h.blas({r.h.aabbs({unitBox()})}))});  // entered at t = 4
+    declare(r, "IS_S", {RAY_FLAG_NONE});
+    std::vector<float> seen;
+    r.is = [&, target](ShaderContext& ctx) {
+        RayQuery<RAY_FLAG_NONE> q(ctx);
+        q.TraceRayInline(target, RAY_FLAG_NONE, 0xFF, zRay());
+        while (q.Proceed()) {
+            seen.push_back(q.CandidateTriangleRayT());
+            if (q.CandidatePrimitiveIndex() == 0) q.CommitNonOpaqueTriangleHit();
+        }
+        if (q.CommittedStatus() == COMMITTED_TRIANGLE_HIT) ctx.ReportHit(q.CommittedRayT() - 20.0f, 3, ProbeAttributes{});
+    };
+    r.args.flags = RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_SKIP_CLOSEST_HIT_SHADER;
+    r.build();
+    const DispatchResult res = r.run({"HG_BoxS_noAH"});
+    EXPECT_TRUE(res.diagnostics.errors().empty());
+    EXPECT_EQ(res.stats.raysPerGatherMode[2], 1u) << "the outer ray took the FirstHit path (GatherMode 2)";
+    EXPECT_EQ(seen, (std::vector<float>{15.0f, 25.0f}));
+    EXPECT_EQ(r.isCalls.load(), 1);
+    EXPECT_EQ(r.result.misses, 0u) << "the hit the intersection shader reported ended the search";
+}
+
 TEST(RayQuery, RQ_2_TheSecondTemplateArgumentIsOptionalAndBothAreConstants) {
     static_assert(std::is_same_v<RayQuery<RAY_FLAG_FORCE_OPAQUE>, RayQuery<RAY_FLAG_FORCE_OPAQUE, RAYQUERY_FLAG_NONE>>);
     static_assert(std::is_base_of_v<RayQueryObject, RayQuery<RAY_FLAG_NONE, RAYQUERY_FLAG_ALLOW_CLUSTERED_GEOMETRY>>);
@@ -1848,6 +1881,32 @@ TEST(ComputeDispatch, RQ_1_UnknownExportsAndTooManyGroupsAreRefused) {
     r.h.device.dispatch(DispatchDesc{"CS", 65535, 1, 1}, r.so, nullptr, one);
     EXPECT_EQ(runs, 65535u);
     expectDxrError("RGS-3", [&] { r.h.device.dispatch(DispatchDesc{"CS"}, nullptr, nullptr); });
+}
+
+TEST(ComputeDispatch, RQ_1_AComputeShaderTracesTheAccelerationStructureOfItsGlobalRootArguments) {
+    Rig r;
+    oneInstance(r, r.h.triangles(triAt(0)), INSTANCE_FLAG_NONE, 23);
+    // RaytracingAccelerationStructure Scene : register(t0); cbuffer Params : register(b0) { float tMax; }
+    const RootSignaturePtr signature = RootSignature::create(
+        {"ComputeGlobal", {RootParameter::srv(0), RootParameter::constants(1, 0)}, ROOT_SIGNATURE_FLAG_NONE});
+    GlobalRootArguments global(signature);
+    global.setDescriptor(0, r.h.scene);
+    global.setConstants(1, 4.0f);
+    std::vector<uint32_t> ids(4, 99);
+    r.h.library->addCompute("CS", uvec3(2, 1, 1), [&](ShaderContext& ctx) {
+        RayQuery<RAY_FLAG_NONE> q(ctx);
+        const float tMax = ctx.globalRootConstants<float>(1);
+        q.TraceRayInline(ctx.globalRootDescriptor(0), RAY_FLAG_NONE, 0xFF, zRay(tMax + float(ctx.DispatchThreadID().x)));
+        while (q.Proceed()) {
+        }
+        ids[ctx.DispatchThreadID().x] = q.CommittedStatus() ? q.CommittedInstanceID() : 0;
+    });
+    declare(r, "CS", {RAY_FLAG_NONE});
+    r.build();
+    EXPECT_TRUE(r.h.device.dispatch(DispatchDesc{"CS", 2, 1, 1}, r.so, &global).diagnostics.errors().empty());
+    EXPECT_EQ(ids, (std::vector<uint32_t>{0, 0, 23, 23}));  // tMax 4, 5 (open: no hit), 6, 7
+    // Without the arguments the read stops with PIPE-6.
+    expectDxrError("PIPE-6", [&] { r.h.device.dispatch(DispatchDesc{"CS", 2, 1, 1}, r.so, nullptr); });
 }
 
 TEST(ComputeDispatch, RQ_19_DiagnosticsNameTheThreadByItsDispatchThreadID) {
