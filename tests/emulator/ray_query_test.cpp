@@ -660,6 +660,36 @@ TEST(RayQuery, RQ_12_ProceedAfterFalseStaysFalseAndDoesNothingWithANote) {
     EXPECT_TRUE(res.diagnostics.errors().empty());
 }
 
+TEST(RayQuery, RQ_12_NotesAreCountedOverTheDispatchAndLocatedAtTheFirstLaunch) {
+    Rig r;
+    oneInstance(r, r.h.triangles(triAt(0), GEOMETRY_FLAG_NONE));
+    declare(r, "RG", {RAY_FLAG_NONE});
+    r.rg = [scene = r.h.scene](ShaderContext& ctx) {
+        const uvec3 i = ctx.DispatchRaysIndex();
+        if (i.x == 0 && i.y == 0) return;  // the first launch makes no note
+        RayQuery<RAY_FLAG_NONE> q(ctx);
+        q.TraceRayInline(scene, RAY_FLAG_NONE, 0xFF, zRay());
+        while (q.Proceed()) {
+        }
+        for (uint32_t k = 0; k < i.x; ++k) q.Proceed();  // after FALSE: i.x notes
+    };
+    std::vector<Diagnostic> seen;
+    for (uint32_t threads : {1u, 2u, 0u}) {
+        DispatchOptions o;
+        o.threads = threads;
+        o.tileSize = 3;
+        const auto notes = runQuery(r, o, uvec3(7, 5, 1)).diagnostics.notes();
+        ASSERT_EQ(notes.size(), 1u) << threads << " threads";
+        const Diagnostic& n = notes[0];
+        EXPECT_EQ(n.ruleId, "RQ-12");
+        EXPECT_EQ(n.count, (1u + 2 + 3 + 4 + 5 + 6) * 5) << threads << " threads";
+        ASSERT_TRUE(n.site);
+        EXPECT_EQ(n.site->launchIndex, uvec3(1, 0, 0)) << threads << " threads";
+        seen.push_back(n);
+    }
+    for (const Diagnostic& n : seen) EXPECT_EQ(n.format(), seen[0].format());
+}
+
 TEST(RayQuery, RQ_13_EveryPrimitiveReallyHitIsEnumeratedInAnyOrder) {
     Rig r;
     // Primitives 0..4 on the ray inside [1, 20]: t = 7, 3, 5, 9, 6. Primitive 5 is off the ray, 6 beyond TMax
