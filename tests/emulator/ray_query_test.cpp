@@ -422,6 +422,44 @@ TEST(RayQuery, RQ_7_CopiesShareOneStateMachine) {
     EXPECT_TRUE(runQuery(r).diagnostics.empty());
 }
 
+TEST(RayQuery, RQ_7_AQueryKeepsItsStateAcrossATraceRayWhoseShadersRunQueriesOfTheirOwn) {
+    Rig r;
+    oneInstance(r, r.h.triangles(trisAt({-2, 0, 2}), GEOMETRY_FLAG_NONE));  // t = 3, 5, 7
+    declare(r, "RG", {RAY_FLAG_NONE});
+    declare(r, "CH_TriS", {RAY_FLAG_FORCE_OPAQUE});
+    float inner = -1.0f;
+    r.chTri = [&, scene = r.h.scene](ShaderContext& ctx, Probe&, const BuiltInTriangleIntersectionAttributes&) {
+        RayQuery<RAY_FLAG_FORCE_OPAQUE> q(ctx);
+        q.TraceRayInline(scene, RAY_FLAG_NONE, 0xFF, RayDesc{vec3(0.0f, 0.2f, -5.0f), 4.0f, vec3(0, 0, 1), 100.0f});
+        EXPECT_FALSE(q.Proceed());
+        inner = q.CommittedRayT();
+    };
+    std::vector<float> outer;
+    r.rg = [&, scene = r.h.scene](ShaderContext& ctx) {
+        RayQuery<RAY_FLAG_NONE> q(ctx);
+        q.TraceRayInline(scene, RAY_FLAG_NONE, 0xFF, zRay());
+        ASSERT_TRUE(q.Proceed());
+        outer.push_back(q.CandidateTriangleRayT());
+        Probe p;
+        ctx.TraceRay(scene, RAY_FLAG_NONE, 0xFF, 0, 1, 0, zRay(), p);  // AHS and CHS run; the CHS makes query 2
+        r.result = p;
+        EXPECT_EQ(q.CandidateTriangleRayT(), 3.0f);
+        q.CommitNonOpaqueTriangleHit();
+        while (q.Proceed()) outer.push_back(q.CandidateTriangleRayT());
+        outer.push_back(q.CommittedRayT());
+    };
+    EventLog log;
+    const DispatchResult res = r.run({"HG_TriS"}, uvec3(1u), observed(log));
+    EXPECT_TRUE(res.diagnostics.errors().empty());
+    EXPECT_EQ(r.result.closestHits, 1u);
+    EXPECT_EQ(r.result.anyHits, 1u);
+    EXPECT_EQ(inner, 5.0f);
+    EXPECT_EQ(outer, (std::vector<float>{3.0f, 3.0f}));
+    std::vector<std::pair<uint32_t, ShaderStage>> inits;
+    for (const auto& e : log.of(TraceEvent::Kind::QueryInit)) inits.push_back({e.queryId, e.stage});
+    EXPECT_EQ(inits, (std::vector<std::pair<uint32_t, ShaderStage>>{{1, ShaderStage::RayGeneration}, {2, ShaderStage::ClosestHit}}));
+}
+
 // RQ-8 says a RayQuery is no wave-repacking point. What refray can observe of that is that a query runs inside the
 // shader that owns it, to the end: it invokes no other shader and reads no shader record, whatever the scene holds.
 TEST(RayQuery, RQ_8_AQueryInvokesNoOtherShaderAndReadsNoRecord) {
