@@ -33,6 +33,7 @@ std::string_view toString(ProfileStage stage) {
 void DispatchStats::merge(const DispatchStats& o) {
     raysTraced += o.raysTraced;
     candidates += o.candidates;
+    rayQueries += o.rayQueries;
     for (size_t i = 0; i < raysPerGatherMode.size(); ++i) raysPerGatherMode[i] += o.raysPerGatherMode[i];
     addPerDepth(raysPerDepth, o.raysPerDepth);
     for (size_t i = 0; i < invocations.size(); ++i) invocations[i] += o.invocations[i];

@@ -57,6 +57,7 @@ struct DispatchStats {
     std::vector<uint64_t> raysPerDepth;  // index = depth of the invoked shaders (1 = primary)
     std::array<uint64_t, kShaderStageCount> invocations{};  // by ShaderStage
     uint64_t candidates = 0;
+    uint64_t rayQueries = 0;  // TraceRayInline calls (emulator/ray_query.h); their candidates count in `candidates`
     // Rays per traversal mode: every candidate gathered, the nearest sure commit bounding the gather, and
     // the occlusion query (DispatchOptions::specialise).
     std::array<uint64_t, 3> raysPerGatherMode{};

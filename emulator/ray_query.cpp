@@ -238,6 +238,7 @@ void RayQueryObject::TraceRayInline(GpuVirtualAddress as, uint32_t rayFlags, uin
     const detail::Site site = detail::siteOf(*q.inv);
     // RQ-9: whatever the state, the current query is discarded.
     q.id = ++ts.queriesTraced;
+    ts.stats.rayQueries++;
     q.phase = QueryPhase::Initialised;
     q.proceeded = false;
     q.searchEnded = false;
@@ -304,7 +305,7 @@ bool RayQueryObject::Proceed() {
         result = detail::advance(q);
         q.phase = result ? QueryPhase::Candidate : QueryPhase::Finished;
     }
-    if (detail::observer(ts)) {
+    if (detail::observer(ts) && q.id != 0) {  // a query never initialised has no life to show
         TraceEvent e = detail::queryEvent(q, TraceEvent::Kind::QueryProceed);
         e.accepted = result;
         if (result) detail::setQueryHit(e, q.candidate);

@@ -33,13 +33,30 @@ TEST(D3D12Shaders, EveryHlslExportExistsWithItsStage) {
         {"MyIntersectionShader_AnalyticPrimitive", ShaderStage::Intersection},
         {"MyIntersectionShader_VolumetricPrimitive", ShaderStage::Intersection},
         {"MyIntersectionShader_SignedDistancePrimitive", ShaderStage::Intersection},
+        // scenes/inline/InlineShadows.hlsl and InlineAmbientOcclusion.hlsl (RQ-1, RQ-2).
+        {"MyClosestHitShader_Triangle_InlineShadow", ShaderStage::ClosestHit},
+        {"MyClosestHitShader_AABB_InlineShadow", ShaderStage::ClosestHit},
+        {"InlineAmbientOcclusionCS", ShaderStage::Compute},
     };
     EXPECT_EQ(lib->exports().size(), expected.size());
     for (const auto& [name, stage] : expected) {
         const ShaderExport* e = lib->find(name);
         ASSERT_NE(e, nullptr) << name;
         EXPECT_EQ(e->stage, stage) << name;
+        // The RayQuery objects each export declares (the HLSL's template flags), and only those.
+        const bool traceShadowsInline = name.find("_InlineShadow") != std::string::npos;
+        if (traceShadowsInline) {
+            EXPECT_EQ(e->rayQueryFlags, std::vector<uint32_t>{RAY_FLAG_CULL_BACK_FACING_TRIANGLES | RAY_FLAG_FORCE_OPAQUE |
+                                                              RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH})
+                << name;
+        } else if (stage != ShaderStage::Compute) {
+            EXPECT_TRUE(e->rayQueryFlags.empty()) << name;
+        }
     }
+    const ShaderExport* cs = lib->find("InlineAmbientOcclusionCS");
+    ASSERT_NE(cs, nullptr);
+    EXPECT_EQ(cs->numThreads, uvec3(8, 8, 1));  // [numthreads(8, 8, 1)]
+    EXPECT_EQ(cs->rayQueryFlags.size(), 2u);
 }
 
 TEST(D3D12Shaders, ExportsDeclareTheHlslPayloadAndAttributeTypes) {
