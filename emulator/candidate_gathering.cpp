@@ -53,8 +53,7 @@ GatherMode traversalMode(const ThreadState& ts, const RayState& rs) {
 }
 
 // Orders candidates per DispatchOptions::order (GEN-3).
-void orderCandidates(ThreadState& ts, RayState& rs) {
-    auto& cs = ts.candidates;
+void orderCandidates(ThreadState& ts, RayState& rs, std::vector<Candidate>& cs) {
     std::sort(cs.begin(), cs.end(), [](const Candidate& a, const Candidate& b) {
         if (a.key != b.key) return a.key < b.key;
         if (a.instanceIndex != b.instanceIndex) return a.instanceIndex < b.instanceIndex;
@@ -81,11 +80,10 @@ void orderCandidates(ThreadState& ts, RayState& rs) {
     std::shuffle(cs.begin(), cs.end(), rng);
 }
 
-}  // namespace
-
-void gatherOrderedCandidates(ThreadState& ts, RayState& rs, const Site& site) {
+// The body of both entry points: `out` receives the candidates, gathered in `mode`.
+void gatherInto(ThreadState& ts, RayState& rs, const Site& site, std::vector<Candidate>& out, GatherMode mode) {
     const DispatchState& ds = *ts.dispatch;
-    ts.candidates.clear();
+    out.clear();
     GatherRequest gather;
     gather.tlas = rs.tlas;
     gather.origin = rs.ray.Origin;
@@ -96,17 +94,27 @@ void gatherOrderedCandidates(ThreadState& ts, RayState& rs, const Site& site) {
     gather.skipTriangles = (rs.effectiveFlags & RAY_FLAG_SKIP_TRIANGLES) != 0;  // FLAG-12
     gather.skipProcedural = (rs.effectiveFlags & RAY_FLAG_SKIP_PROCEDURAL_PRIMITIVES) != 0;
     gather.alternateEdgeRule = ds.options.order == TraversalOrder::Adversarial && (ds.options.adversarialSeed & 1);
-    gather.out = &ts.candidates;
+    gather.out = &out;
     ShortcutContext shortcut{&ts, &rs, &site};
     gather.user = &shortcut;
     gather.commitsSurely = commitsSurely;
     gather.onCandidate = processNow;
-    gather.mode = traversalMode(ts, rs);
+    gather.mode = mode;
     ts.stats.raysPerGatherMode[size_t(gather.mode)]++;
     gatherCandidates(gather);
-    if (gather.mode != GatherMode::FirstHit) ts.stats.candidates += ts.candidates.size();
-    else ts.candidates.clear();  // processed during the traversal
-    orderCandidates(ts, rs);
+    if (gather.mode != GatherMode::FirstHit) ts.stats.candidates += out.size();
+    else out.clear();  // processed during the traversal
+    orderCandidates(ts, rs, out);
+}
+
+}  // namespace
+
+void gatherOrderedCandidates(ThreadState& ts, RayState& rs, const Site& site) {
+    gatherInto(ts, rs, site, ts.candidates, traversalMode(ts, rs));
+}
+
+void gatherQueryCandidates(ThreadState& ts, RayState& rs, const Site& site, std::vector<Candidate>& out) {
+    gatherInto(ts, rs, site, out, GatherMode::All);
 }
 
 }  // namespace refray::dxr::detail

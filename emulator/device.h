@@ -53,6 +53,13 @@ public:
     DispatchResult dispatchRays(const DispatchRaysDesc& desc, const StateObjectPtr& pipeline,
                                 const GlobalRootArguments* globalArguments, const DispatchOptions& options = {});
 
+    // Dispatch of a compute shader (RQ-1: inline ray tracing from compute): ThreadGroupCount* groups of the export's
+    // numthreads, each thread one invocation of stage Compute with the global root arguments. TraceRay and
+    // CallShader are not available there (RAY-2, CALL-2); RayQuery is. Throws DxrError for an unknown export or a
+    // group count past 65535, and on the first error (OnError::Stop).
+    DispatchResult dispatch(const DispatchDesc& desc, const StateObjectPtr& pipeline,
+                            const GlobalRootArguments* globalArguments, const DispatchOptions& options = {});
+
     // Increments whenever any BLAS is built or updated (INST-8 staleness checks).
     uint64_t accelerationStructureEpoch() const { return epoch_.load(); }
 

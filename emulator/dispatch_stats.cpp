@@ -25,7 +25,9 @@ std::string toString(const RayTypeKey& key) {
 uint64_t RayTypeCounts::total() const { return std::accumulate(raysPerDepth.begin(), raysPerDepth.end(), uint64_t(0)); }
 
 std::string_view toString(ProfileStage stage) {
-    return stage == ProfileStage::Traversal ? std::string_view("traversal") : toString(ShaderStage(uint8_t(stage)));
+    if (stage == ProfileStage::Traversal) return "traversal";
+    if (stage == ProfileStage::Compute) return "compute";
+    return toString(ShaderStage(uint8_t(stage)));
 }
 
 void DispatchStats::merge(const DispatchStats& o) {

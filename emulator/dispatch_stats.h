@@ -44,16 +44,18 @@ struct ExportInvocations {
 // closest-hit shader's time excludes the rays it traces, which count as traversal and as the shaders they
 // invoke. Traversal is TraceRay's own work: validation, Embree and candidate gathering, ordering, the
 // TRV-4 loop and record lookups, without any shader time. The first six follow ShaderStage.
-enum class ProfileStage : uint8_t { RayGeneration, Intersection, AnyHit, ClosestHit, Miss, Callable, Traversal };
-inline constexpr size_t kProfileStageCount = 7;
-constexpr ProfileStage profileStageOf(ShaderStage stage) { return ProfileStage(uint8_t(stage)); }
+enum class ProfileStage : uint8_t { RayGeneration, Intersection, AnyHit, ClosestHit, Miss, Callable, Traversal, Compute };
+inline constexpr size_t kProfileStageCount = 8;
+constexpr ProfileStage profileStageOf(ShaderStage stage) {
+    return stage == ShaderStage::Compute ? ProfileStage::Compute : ProfileStage(uint8_t(stage));
+}
 // "raygeneration", ..., "callable" (as ShaderStage), "traversal".
 std::string_view toString(ProfileStage stage);
 
 struct DispatchStats {
     uint64_t raysTraced = 0;
     std::vector<uint64_t> raysPerDepth;  // index = depth of the invoked shaders (1 = primary)
-    std::array<uint64_t, 6> invocations{};  // by ShaderStage
+    std::array<uint64_t, kShaderStageCount> invocations{};  // by ShaderStage
     uint64_t candidates = 0;
     // Rays per traversal mode: every candidate gathered, the nearest sure commit bounding the gather, and
     // the occlusion query (DispatchOptions::specialise).

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "core/strings.h"
 #include "emulator/detail/dispatch_errors.h"
 #include "emulator/detail/dispatch_state.h"
 #include "emulator/detail/record_lookup.h"
@@ -139,10 +140,13 @@ void runLaunch(ThreadState& ts, DispatchState& ds, uvec3 launch) {
     ts.linearIndex = linearIndex(*ds.desc, launch);
     if (ts.linearIndex > ds.firstErrorIndex.load(std::memory_order_relaxed)) return;
     ts.rayCounter = 0;
+    ts.queriesTraced = 0;
     detail::Invocation inv =
-        detail::invocation(ts, ShaderStage::RayGeneration, ds.rayGenRecord.entry->shader, &ds.rayGenRecord, 0);
+        ds.computeShader
+            ? detail::invocation(ts, ShaderStage::Compute, ds.computeShader, nullptr, 0)
+            : detail::invocation(ts, ShaderStage::RayGeneration, ds.rayGenRecord.entry->shader, &ds.rayGenRecord, 0);
     try {
-        detail::checkGlobalSignature(ts, detail::siteOf(inv), *ds.rayGenRecord.entry);
+        if (!ds.computeShader) detail::checkGlobalSignature(ts, detail::siteOf(inv), *ds.rayGenRecord.entry);
         detail::invoke(ts, inv, nullptr, nullptr);
     } catch (const DxrError& e) {
         recordStopError(ts, ds, e.diagnostic());
@@ -198,6 +202,19 @@ void collectResults(ThreadStates& threadStates, const DispatchRaysDesc& desc, Di
     }
 }
 
+// Runs every launch of `region` on per-thread states and merges their diagnostics and statistics into `result`.
+void runLaunches(DispatchState& ds, const LaunchRegion& region, DispatchResult& result) {
+    ThreadStates threadStates([&] {
+        ThreadState ts;
+        ts.dispatch = &ds;
+        ts.candidates.reserve(64);
+        ts.profiling = ds.options.profileStages;
+        return ts;
+    });
+    runTiles(ds, region, threadStates);
+    collectResults(threadStates, *ds.desc, result);
+}
+
 }  // namespace
 
 DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObjectPtr& pipeline,
@@ -225,16 +242,51 @@ DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObj
     if (ds.rayGenRecord.entry && launches != 0) {  // else REC-8: NULL ray generation; RGS-1: zero size
         const TableLock lock(memory_, {desc.RayGenerationShaderRecord.StartAddress, desc.MissShaderTable.StartAddress,
                                        desc.HitGroupTable.StartAddress, desc.CallableShaderTable.StartAddress});
-        ThreadStates threadStates([&] {
-            ThreadState ts;
-            ts.dispatch = &ds;
-            ts.candidates.reserve(64);
-            ts.profiling = options.profileStages;
-            return ts;
-        });
-        runTiles(ds, region, threadStates);
-        collectResults(threadStates, desc, result);
+        runLaunches(ds, region, result);
     }
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+DispatchResult Device::dispatch(const DispatchDesc& desc, const StateObjectPtr& pipeline,
+                                const GlobalRootArguments* globalArguments, const DispatchOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
+    if (!pipeline) throw DxrError(diag("RGS-3", "Dispatch without a bound state object holding the compute shader"));
+    const ShaderExport* shader = pipeline->findComputeShader(desc.ComputeShader);
+    if (!shader) {
+        std::vector<std::string> names;
+        for (const auto& [n, e] : pipeline->computeShaders()) names.push_back(n);
+        throw DxrError(diag("RQ-1", "Dispatch names no compute shader of state object '" + pipeline->name() + "'")
+                           .value("ComputeShader", desc.ComputeShader)
+                           .value("compute exports", names.empty() ? std::string("(none)") : joined(names)));
+    }
+    for (uint32_t groups : {desc.ThreadGroupCountX, desc.ThreadGroupCountY, desc.ThreadGroupCountZ})
+        if (groups > kMaxThreadGroupsPerDimension)
+            throw DxrError(diag("RQ-1", "Dispatch thread-group count above D3D12's 65535 per dimension")
+                               .value("ThreadGroupCountX", desc.ThreadGroupCountX, "<= 65535")
+                               .value("ThreadGroupCountY", desc.ThreadGroupCountY, "<= 65535")
+                               .value("ThreadGroupCountZ", desc.ThreadGroupCountZ, "<= 65535"));
+    checkGlobalArguments(globalArguments);
+    // The launch grid is the grid of SV_DispatchThreadID.
+    DispatchRaysDesc grid;
+    grid.Width = desc.ThreadGroupCountX * shader->numThreads.x;
+    grid.Height = desc.ThreadGroupCountY * shader->numThreads.y;
+    grid.Depth = desc.ThreadGroupCountZ * shader->numThreads.z;
+    const LaunchRegion region = launchRegion(grid, options);
+
+    DispatchState ds;
+    ds.device = this;
+    ds.memory = &memory_;
+    ds.pipeline = pipeline.get();
+    ds.desc = &grid;
+    ds.global = globalArguments;
+    ds.options = options;
+    ds.epoch = epoch_.load();
+    ds.computeShader = shader;
+
+    DispatchResult result;
+    result.stats.stagesProfiled = options.profileStages;
+    if (uint64_t(grid.Width) * grid.Height * grid.Depth != 0) runLaunches(ds, region, result);
     result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
 }

@@ -58,6 +58,18 @@ struct DispatchOptions {
     bool specialise = true;
 };
 
+// ID3D12GraphicsCommandList::Dispatch with a compute pipeline state whose shader is `ComputeShader`, a compute
+// export of the bound state object's libraries (its [numthreads] comes with the export). Threads run in the launch
+// order of DispatchRays over the grid of SV_DispatchThreadID, so diagnostics name a thread by that id.
+struct DispatchDesc {
+    std::string ComputeShader;
+    uint32_t ThreadGroupCountX = 1;
+    uint32_t ThreadGroupCountY = 1;
+    uint32_t ThreadGroupCountZ = 1;
+};
+// D3D12_CS_DISPATCH_MAX_THREAD_GROUPS_PER_DIMENSION.
+inline constexpr uint32_t kMaxThreadGroupsPerDimension = 65535;
+
 struct DispatchResult {
     DiagnosticLog diagnostics;  // warnings, plus the errors in OnError::Continue mode
     DispatchStats stats;

@@ -36,14 +36,36 @@ void ShaderContext::calledAfterSearchEnded(const char* intrinsic) const {
 }
 
 uvec3 ShaderContext::DispatchRaysIndex() const {
-    requireLive("DispatchRaysIndex");
+    requireStage(kRayTracingStages, "DispatchRaysIndex");
     return inv_.thread->launchIndex;
 }
 
 uvec3 ShaderContext::DispatchRaysDimensions() const {
-    requireLive("DispatchRaysDimensions");
+    requireStage(kRayTracingStages, "DispatchRaysDimensions");
     const DispatchRaysDesc& d = *inv_.dispatch->desc;
     return {d.Width, d.Height, d.Depth};
+}
+
+uvec3 ShaderContext::DispatchThreadID() const {
+    requireStage(bit(ShaderStage::Compute), "DispatchThreadID");
+    return inv_.thread->launchIndex;
+}
+
+uvec3 ShaderContext::GroupID() const {
+    requireStage(bit(ShaderStage::Compute), "GroupID");
+    return inv_.thread->launchIndex / inv_.shader->numThreads;
+}
+
+uvec3 ShaderContext::GroupThreadID() const {
+    requireStage(bit(ShaderStage::Compute), "GroupThreadID");
+    return inv_.thread->launchIndex % inv_.shader->numThreads;
+}
+
+uint32_t ShaderContext::GroupIndex() const {
+    requireStage(bit(ShaderStage::Compute), "GroupIndex");
+    const uvec3 t = inv_.thread->launchIndex % inv_.shader->numThreads;
+    const uvec3 n = inv_.shader->numThreads;
+    return (t.z * n.y + t.y) * n.x + t.x;
 }
 
 float ShaderContext::RayTCurrent() const {

@@ -16,6 +16,7 @@
 #include "core/image.h"
 #include "emulator/descriptor_heap.h"
 #include "emulator/detail/invocation.h"
+#include "emulator/ray_query.h"
 
 namespace refray::dxr {
 
@@ -26,6 +27,7 @@ struct ArgumentBytes;  // dispatch_state.h
 }  // namespace detail
 
 class ShaderContext;
+class RayQueryObject;
 
 // HLSL SamplerState: a sampler resolved from an s register by ShaderContext::SamplerState. Valid for the dispatch
 // that resolved it.
@@ -75,9 +77,15 @@ public:
 
     ShaderStage stage() const { return inv_.stage; }
 
-    // --- Launch (SV-2), every stage.
+    // --- Launch (SV-2), every ray-tracing stage.
     uvec3 DispatchRaysIndex() const;
     uvec3 DispatchRaysDimensions() const;
+
+    // --- Compute shaders (Device::dispatch): SV_DispatchThreadID, SV_GroupID, SV_GroupThreadID, SV_GroupIndex.
+    uvec3 DispatchThreadID() const;
+    uvec3 GroupID() const;
+    uvec3 GroupThreadID() const;
+    uint32_t GroupIndex() const;
 
     // --- Ray values (SV-3..SV-6): IS, AHS, CHS, miss.
     vec3 WorldRayOrigin() const { return rayState(kRay, "WorldRayOrigin").ray.Origin; }
@@ -220,10 +228,13 @@ public:
     }
 
 private:
+    friend class RayQueryObject;  // a query belongs to the invocation that made it (emulator/ray_query.h)
+
     // Stage masks for SV-1.
     static constexpr uint8_t bit(ShaderStage s) { return detail::stageBit(s); }
     static constexpr uint8_t kRay = detail::stageBit(ShaderStage::Intersection) | detail::stageBit(ShaderStage::AnyHit) |
                                     detail::stageBit(ShaderStage::ClosestHit) | detail::stageBit(ShaderStage::Miss);
+    static constexpr uint8_t kRayTracingStages = uint8_t(~detail::stageBit(ShaderStage::Compute));
     static constexpr uint8_t kHit = detail::stageBit(ShaderStage::Intersection) | detail::stageBit(ShaderStage::AnyHit) |
                                     detail::stageBit(ShaderStage::ClosestHit);
 

@@ -37,6 +37,19 @@ void ShaderLibrary::addRayGeneration(std::string name, std::function<void(Shader
          [fn = std::move(fn)](ShaderContext& c, void*, const void*) { fn(c); }});
 }
 
+void ShaderLibrary::addCompute(std::string name, uvec3 numThreads, std::function<void(ShaderContext&)> fn) {
+    REFRAY_CHECK(numThreads.x >= 1 && numThreads.y >= 1 && numThreads.z >= 1 && numThreads.z <= 64 &&
+                     uint64_t(numThreads.x) * numThreads.y * numThreads.z <= 1024 && numThreads.x <= 1024 &&
+                     numThreads.y <= 1024,
+                 "compute shader '" << name << "': numthreads(" << numThreads.x << ", " << numThreads.y << ", "
+                                    << numThreads.z << ") is outside D3D12's limits (x, y <= 1024, z <= 64, "
+                                    << "x*y*z <= 1024)");
+    ShaderExport e{std::move(name), ShaderStage::Compute, {}, {}, {},
+                   [fn = std::move(fn)](ShaderContext& c, void*, const void*) { fn(c); }};
+    e.numThreads = numThreads;
+    add(std::move(e));
+}
+
 void ShaderLibrary::add(ShaderExport e) {
     REFRAY_CHECK(!e.name.empty(), "a shader export needs a name");
     REFRAY_CHECK(e.function, "shader export '" << e.name << "' has no function");
@@ -207,6 +220,7 @@ std::shared_ptr<const StateObject> StateObject::create(const StateObjectDesc& de
             REFRAY_CHECK(!shaders.count(n), "state object '" << desc.name << "': export '" << n
                                                              << "' comes from two libraries");
             shaders[n] = e;
+            if (e->stage == ShaderStage::Compute) so->computeShaders_[n] = e;
         }
     }
     std::vector<std::string> shaderNames;
@@ -362,6 +376,11 @@ std::shared_ptr<const StateObject> StateObject::create(const StateObjectDesc& de
 const ProgramEntry* StateObject::findEntry(const std::string& exportName) const {
     auto it = byName_.find(exportName);
     return it == byName_.end() ? nullptr : &entries_[it->second];
+}
+
+const ShaderExport* StateObject::findComputeShader(const std::string& exportName) const {
+    auto it = computeShaders_.find(exportName);
+    return it == computeShaders_.end() ? nullptr : it->second;
 }
 
 const uint8_t* StateObject::GetShaderIdentifier(const std::string& exportName) const {

@@ -61,6 +61,7 @@ struct ShaderExport {
     TypeTag parameters;  // callable
     ErasedShader function;
     ReportHitEnd reportHitEnd = ReportHitEnd::Unwind;  // IS
+    uvec3 numThreads{1u};  // compute: [numthreads(x, y, z)]
 };
 
 // A DXIL library: named shader exports. Signatures mirror HLSL entry points:
@@ -69,6 +70,9 @@ struct ShaderExport {
 class ShaderLibrary {
 public:
     void addRayGeneration(std::string name, std::function<void(ShaderContext&)> fn);
+    // [numthreads(x, y, z)] [shader("compute")] void CS(uint3 id : SV_DispatchThreadID): run by Device::dispatch, not
+    // part of the ray-tracing pipeline (no identifier); it reads its thread ids from ShaderContext.
+    void addCompute(std::string name, uvec3 numThreads, std::function<void(ShaderContext&)> fn);
     template <class Attributes>
     void addIntersection(std::string name, std::function<void(ShaderContext&)> fn,
                          ReportHitEnd end = ReportHitEnd::Unwind) {
@@ -191,6 +195,10 @@ public:
     // The same, but throws refray::Error with a "did you mean" for an unknown name.
     ShaderIdentifier shaderIdentifier(const std::string& exportName) const;
     const ProgramEntry* findEntry(const std::string& exportName) const;
+    // A compute export of the state object's libraries (Device::dispatch), or nullptr.
+    const ShaderExport* findComputeShader(const std::string& exportName) const;
+    // Every compute export, by name.
+    const std::map<std::string, const ShaderExport*>& computeShaders() const { return computeShaders_; }
 
     // Decodes 32 identifier bytes: the entry, or nullptr when they are not an identifier
     // of this state object (the caller reports REC-8/REC-9). isNull is set for all zeros.
@@ -205,6 +213,7 @@ private:
     PipelineConfig pipelineConfig_;
     std::vector<ProgramEntry> entries_;
     std::map<std::string, uint32_t> byName_;
+    std::map<std::string, const ShaderExport*> computeShaders_;
     std::vector<std::shared_ptr<const ShaderLibrary>> libraries_;  // keeps exports alive
 };
 

@@ -26,9 +26,16 @@ struct TraceEvent {
         AnyHit,        // an any-hit shader decided: note ("accept", "IgnoreHit", "AcceptHitAndEndSearch")
         Commit,        // a candidate became the closest hit: instance, geometry, primitive, t, hitKind
         TraceRayEnd,   // the ray is done: committed (hit) or not (miss); payload = what TraceRay returns
+        // RayQuery (emulator/ray_query.h), each with queryId, stage and exportName of the owning shader. The query's
+        // walk over its candidates reuses Candidate and Skipped (with queryId set).
+        QueryInit,     // TraceRayInline: accelerationStructure, ray, rayFlags (dynamic), effectiveFlags (OR'd), mask
+        QueryProceed,  // Proceed returned `accepted`: the candidate (instance.., procedural, t) when TRUE; note
+        QueryCommit,   // a hit was committed: by the system or the shader (note), instance.., procedural, t
+        QueryAbort,    // Abort: committed, t = CommittedRayT
     };
     Kind kind = Kind::ShaderCall;
     uvec3 launchIndex{0u};
+    uint32_t queryId = 0;  // RayQuery events and the candidates of a query: the query's number on this launch (from 1)
     uint32_t depth = 0;  // the recursion level of the shaders this event belongs to (ray generation = 0)
 
     // TraceRay: its arguments (raw, as passed; the rule masks R and M).

@@ -45,24 +45,31 @@ std::string describeCallChain(const ThreadState& ts) {
 // Embree's traversal accepts origin and direction components up to ±1.844e18 (its FLT_LARGE) and asserts
 // beyond; refray treats a finite ray beyond that like an infinite one (RAY-7: a warning, then a miss).
 constexpr float kTraversalRange = 1.844e18f;
+
+}  // namespace
+
 bool inTraversalRange(const RayDesc& ray) {
     for (int c = 0; c < 3; ++c)
         if (!(std::fabs(ray.Origin[c]) <= kTraversalRange && std::fabs(ray.Direction[c]) <= kTraversalRange)) return false;
     return true;
 }
 
+namespace {
+
 std::string vec3Values(const vec3& v) {
     return std::to_string(v.x) + "," + std::to_string(v.y) + "," + std::to_string(v.z);
 }
 
-void validateRay(ThreadState& ts, const Site& site, const RayDesc& ray, bool& ok) {
+}  // namespace
+
+void validateRay(ThreadState& ts, const Site& site, const RayDesc& ray, bool& ok, const char* rule) {
     // inTraversalRange also fails for NaN and infinite components, so it covers their finiteness too.
     if (inTraversalRange(ray) && std::isfinite(ray.TMin) && !std::isnan(ray.TMax) && ray.TMin >= 0.0f &&
         ray.TMin <= ray.TMax && ray.Direction != vec3(0.0f))
         return;  // the common case: nothing to report
     auto field = [&](const char* name, float v) {
         if (std::isnan(v)) {
-            raise(ts, site, diag("RAY-5", std::string("RayDesc.") + name + " is NaN").value(name, v));
+            raise(ts, site, diag(rule, std::string("RayDesc.") + name + " is NaN").value(name, v));
             ok = false;
         }
     };
@@ -76,14 +83,14 @@ void validateRay(ThreadState& ts, const Site& site, const RayDesc& ray, bool& ok
     field("TMax", ray.TMax);
     if (!ok) return;
     if (ray.TMin < 0.0f) {
-        raise(ts, site, diag("RAY-5", "RayDesc.TMin is negative").value("TMin", ray.TMin, ">= 0"));
+        raise(ts, site, diag(rule, "RayDesc.TMin is negative").value("TMin", ray.TMin, ">= 0"));
         ok = false;
     } else if (ray.TMin > ray.TMax) {
-        raise(ts, site, diag("RAY-5", "RayDesc.TMin is greater than TMax").value("TMin", ray.TMin).value("TMax", ray.TMax, ">= TMin"));
+        raise(ts, site, diag(rule, "RayDesc.TMin is greater than TMax").value("TMin", ray.TMin).value("TMax", ray.TMax, ">= TMin"));
         ok = false;
     }
     if (std::isinf(ray.TMin))
-        warn(ts, site, warning("RAY-5", "RayDesc.TMin is infinite; no hit can follow").value("TMin", ray.TMin));
+        warn(ts, site, warning(rule, "RayDesc.TMin is infinite; no hit can follow").value("TMin", ray.TMin));
     if (ray.Direction == vec3(0.0f))
         warn(ts, site, warning("RAY-7", "RayDesc.Direction is the zero vector"));
     else if (!allFinite(ray.Origin) || !allFinite(ray.Direction))
@@ -97,13 +104,19 @@ void validateRay(ThreadState& ts, const Site& site, const RayDesc& ray, bool& ok
                            .value("Direction", vec3Values(ray.Direction)));
 }
 
-// FLAG-2..5 on the effective flags; returns false (and has raised) when they are invalid.
-bool validateFlags(ThreadState& ts, const Site& site, uint32_t rayFlags, uint32_t pipelineFlags) {
+bool validateFlags(ThreadState& ts, const Site& site, uint32_t rayFlags, uint32_t pipelineFlags,
+                   const char* queryRule) {
     const uint32_t eff = rayFlags | pipelineFlags;
     auto fail = [&](const char* rule, const std::string& what) {
-        raise(ts, site, diag(rule, what)
-                            .value("TraceRay flags", rayFlagsToString(rayFlags))
-                            .value("pipeline flags", pipelineFlagsToString(pipelineFlags)));
+        if (queryRule)
+            raise(ts, site, diag(queryRule, what)
+                                .value("template flags", rayFlagsToString(pipelineFlags))
+                                .value("TraceRayInline flags", rayFlagsToString(rayFlags))
+                                .value("OR'd", rayFlagsToString(eff)));
+        else
+            raise(ts, site, diag(rule, what)
+                                .value("TraceRay flags", rayFlagsToString(rayFlags))
+                                .value("pipeline flags", pipelineFlagsToString(pipelineFlags)));
         return false;
     };
     const uint32_t opacity = eff & (RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_FORCE_NON_OPAQUE | RAY_FLAG_CULL_OPAQUE | RAY_FLAG_CULL_NON_OPAQUE);
@@ -118,6 +131,8 @@ bool validateFlags(ThreadState& ts, const Site& site, uint32_t rayFlags, uint32_
                     "SKIP_TRIANGLES excludes CULL_*_FACING_TRIANGLES and SKIP_PROCEDURAL_PRIMITIVES");
     return true;
 }
+
+namespace {
 
 // The TraceRay and TraceRayEnd events. `asAddress` and `mask` are the TraceRay arguments as passed.
 void emitRay(const ThreadState& ts, const RayState& rs, TraceEvent::Kind kind, GpuVirtualAddress asAddress,
@@ -229,6 +244,16 @@ void runClosestHitOrMiss(ThreadState& ts, RayState& rs, const Site& site) {
 
 }  // namespace
 
+const TopLevelAS* findTopLevelAS(ThreadState& ts, const Site& site, GpuVirtualAddress asAddress) {
+    const TopLevelAS* tlas = lookupTopLevelAS(ts, asAddress);
+    if (!tlas) {
+        raiseNotTopLevelAS(ts, site, asAddress);
+        return nullptr;
+    }
+    if (tlas->checkedEpoch() != ts.dispatch->epoch && !checkBottomLevelsCurrent(ts, site, *tlas)) return nullptr;
+    return tlas;
+}
+
 void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags, uint32_t mask, uint32_t r,
               uint32_t m, uint32_t missIndex, const RayDesc& ray, void* payload, TypeTag payloadType) {
     ThreadState& ts = *caller.thread;
@@ -250,7 +275,7 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
     }
     if (!validateFlags(ts, site, rayFlags, ds.pipeline->pipelineFlags())) return;
     bool rayOk = true;
-    validateRay(ts, site, ray, rayOk);
+    validateRay(ts, site, ray, rayOk, "RAY-5");
     if (!rayOk) return;
     if ((r & ~kRayContributionMask) || (m & ~kGeometryMultiplierMask))  // IDX-2
         warn(ts, site, warning("IDX-2", "TraceRay index arguments have bits above the low 4; DXR ignores them")
@@ -281,12 +306,8 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
     // components beyond Embree's range get the same treatment. Embree never sees either kind of ray.
     const bool traceable = inTraversalRange(ray);  // false for NaN and infinite components too
     if (asAddress != 0 && traceable) {
-        rs.tlas = lookupTopLevelAS(ts, asAddress);
-        if (!rs.tlas) {
-            raiseNotTopLevelAS(ts, site, asAddress);
-            return;
-        }
-        if (rs.tlas->checkedEpoch() != ds.epoch && !checkBottomLevelsCurrent(ts, site, *rs.tlas)) return;
+        rs.tlas = findTopLevelAS(ts, site, asAddress);
+        if (!rs.tlas) return;
         gatherOrderedCandidates(ts, rs, site);
         processCandidates(ts, rs, site);
     }

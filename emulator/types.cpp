@@ -14,6 +14,7 @@ std::string_view toString(ShaderStage stage) {
         case ShaderStage::ClosestHit: return "closesthit";
         case ShaderStage::Miss: return "miss";
         case ShaderStage::Callable: return "callable";
+        case ShaderStage::Compute: return "compute";
     }
     return "unknown";
 }

@@ -71,7 +71,9 @@ struct BuiltInTriangleIntersectionAttributes {
     vec2 barycentrics{0.0f};
 };
 
-enum class ShaderStage : uint8_t { RayGeneration, Intersection, AnyHit, ClosestHit, Miss, Callable };
+// Compute: a compute shader of Device::dispatch (inline ray tracing from compute, RQ-1); not a ray-tracing stage.
+enum class ShaderStage : uint8_t { RayGeneration, Intersection, AnyHit, ClosestHit, Miss, Callable, Compute };
+inline constexpr size_t kShaderStageCount = 7;
 std::string_view toString(ShaderStage stage);
 
 // Names a flag set ("CULL_BACK_FACING_TRIANGLES|FORCE_OPAQUE"); unknown bits as hex.

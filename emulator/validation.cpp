@@ -9,7 +9,8 @@ namespace refray::dxr {
 
 std::string Diagnostic::format() const {
     std::ostringstream s;
-    s << (severity == Severity::Error ? "error " : "warning ") << ruleId << ": " << message;
+    s << (severity == Severity::Error ? "error " : severity == Severity::Note ? "note " : "warning ") << ruleId << ": "
+      << message;
     if (site) {
         s << " [launch (" << site->launchIndex.x << "," << site->launchIndex.y << "," << site->launchIndex.z
           << "), depth " << site->depth << ", " << toString(site->stage);
@@ -72,6 +73,13 @@ std::vector<Diagnostic> DiagnosticLog::warnings() const {
     std::vector<Diagnostic> out;
     for (auto& d : diagnostics())
         if (d.severity == Severity::Warning) out.push_back(d);
+    return out;
+}
+
+std::vector<Diagnostic> DiagnosticLog::notes() const {
+    std::vector<Diagnostic> out;
+    for (auto& d : diagnostics())
+        if (d.severity == Severity::Note) out.push_back(d);
     return out;
 }
 

@@ -19,7 +19,8 @@
 
 namespace refray::dxr {
 
-enum class Severity : uint8_t { Warning, Error };
+// Note: a use DXR defines that another API leaves undefined (RayQuery, dxr-semantics.md 18e); never a warning.
+enum class Severity : uint8_t { Warning, Error, Note };
 
 struct DiagnosticValue {
     std::string name;
@@ -68,6 +69,7 @@ public:
     std::vector<Diagnostic> diagnostics() const;
     std::vector<Diagnostic> errors() const;
     std::vector<Diagnostic> warnings() const;
+    std::vector<Diagnostic> notes() const;
     bool empty() const { return records_.empty(); }
     // Finds the first record with this rule id.
     std::optional<Diagnostic> find(const std::string& ruleId) const;

@@ -17,6 +17,7 @@ std::string_view stageExtension(ShaderStage stage) {
         case ShaderStage::ClosestHit: return "rchit";
         case ShaderStage::Miss: return "rmiss";
         case ShaderStage::Callable: return "rcall";
+        case ShaderStage::Compute: return "comp";
     }
     return "";
 }
@@ -29,6 +30,7 @@ VkShaderStageFlagBits translateStage(ShaderStage stage) {
         case ShaderStage::ClosestHit: return VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR;
         case ShaderStage::Miss: return VK_SHADER_STAGE_MISS_BIT_KHR;
         case ShaderStage::Callable: return VK_SHADER_STAGE_CALLABLE_BIT_KHR;
+        case ShaderStage::Compute: return VK_SHADER_STAGE_COMPUTE_BIT;
     }
     return VK_SHADER_STAGE_RAYGEN_BIT_KHR;
 }

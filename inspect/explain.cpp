@@ -248,6 +248,39 @@ struct TextWriter {
     void line(uint32_t indent, const std::string& text) { out << std::string(indent * 2, ' ') << text << '\n'; }
 };
 
+// One step of a RayQuery's life (emulator/ray_query.h) at `level`: TraceRayInline, each candidate and what the system
+// did with it, each Proceed and what it handed the shader, each commit (the shader's decision) and Abort.
+void writeQueryEvent(TextWriter& w, const SceneDesc& scene, const RecordedEvent& r, uint32_t level) {
+    const TraceEvent& e = r.event;
+    const std::string q = "RayQuery #" + std::to_string(e.queryId);
+    switch (e.kind) {
+        case Kind::QueryInit:
+            w.line(level, q + " in " + std::string(dxr::toString(e.stage)) + " shader '" + r.exportName +
+                              "': TraceRayInline (no shader table: the owning shader decides for each candidate)");
+            w.line(level + 1, "origin " + vec3Text(e.ray.Origin) + "  direction " + vec3Text(e.ray.Direction) + "  TMin " +
+                                  shortestFloat(e.ray.TMin) + "  TMax " + shortestFloat(e.ray.TMax));
+            w.line(level + 1, "RayFlags (template | TraceRayInline) " + dxr::rayFlagsToString(e.effectiveFlags) +
+                                  "  InstanceInclusionMask " + hexText(e.instanceInclusionMask));
+            break;
+        case Kind::Candidate:
+            w.line(level + 1, q + " candidate: " + hitText(scene, e) +
+                                  (e.procedural ? ", AABB entered at t = " + shortestFloat(e.t) : ", triangle at t = " + shortestFloat(e.t)));
+            break;
+        case Kind::Skipped: w.line(level + 2, "skipped by the system: " + r.note); break;
+        case Kind::QueryProceed:
+            w.line(level, q + " Proceed() = " + (e.accepted ? std::string("TRUE") : std::string("FALSE")) + ": " + r.note +
+                              (e.accepted ? " (" + hitText(scene, e) + (e.procedural ? ", box entry t = " : ", t = ") + shortestFloat(e.t) + ")"
+                                          : "; CommittedRayT = " + shortestFloat(e.t) +
+                                                (e.committed ? "" : " (COMMITTED_NOTHING: TMax)")));
+            break;
+        case Kind::QueryCommit:
+            w.line(level + 1, q + " commit: " + r.note + ": " + hitText(scene, e) + ", CommittedRayT = " + shortestFloat(e.t));
+            break;
+        case Kind::QueryAbort: w.line(level, q + " Abort(): " + r.note); break;
+        default: break;
+    }
+}
+
 }  // namespace
 
 std::string formatExplanation(const Explanation& x, const SceneDesc& scene) {
@@ -262,6 +295,10 @@ std::string formatExplanation(const Explanation& x, const SceneDesc& scene) {
         const TraceEvent& e = r.event;
         // Levels: a TraceRay of depth d at 3d-2, its details at 3d-1, what it runs at 3d, inside those at 3d+1.
         const uint32_t base = e.depth == 0 ? 0 : 3 * e.depth - 1;
+        if (e.queryId != 0) {  // a RayQuery's life, inside the shader that owns it
+            writeQueryEvent(w, scene, r, base + (e.depth == 0 ? 1 : 2));
+            continue;
+        }
         switch (e.kind) {
             case Kind::ShaderCall: {
                 const std::string stage(dxr::toString(e.stage));
@@ -325,6 +362,10 @@ std::string formatExplanation(const Explanation& x, const SceneDesc& scene) {
             case Kind::Commit:
                 w.line(base + 1, "commit: " + hitText(scene, e) + ", t = " + shortestFloat(e.t) + ", HitKind " + hitKindText(e.hitKind));
                 break;
+            case Kind::QueryInit:
+            case Kind::QueryProceed:
+            case Kind::QueryCommit:
+            case Kind::QueryAbort: break;  // every query event has a queryId: written above
             case Kind::TraceRayEnd: {
                 const uint32_t number = rayStack.empty() ? 0 : rayStack.back();
                 if (!rayStack.empty()) rayStack.pop_back();
@@ -362,6 +403,10 @@ const char* kindName(Kind k) {
         case Kind::AnyHit: return "anyHit";
         case Kind::Commit: return "commit";
         case Kind::TraceRayEnd: return "traceRayEnd";
+        case Kind::QueryInit: return "queryInit";
+        case Kind::QueryProceed: return "queryProceed";
+        case Kind::QueryCommit: return "queryCommit";
+        case Kind::QueryAbort: return "queryAbort";
     }
     return "?";
 }
@@ -398,6 +443,7 @@ std::string explanationJson(const Explanation& x, const SceneDesc& scene) {
         const RecordedEvent& r = x.events[i];
         const TraceEvent& e = r.event;
         o << "    {\"kind\": \"" << kindName(e.kind) << "\", \"depth\": " << e.depth;
+        if (e.queryId != 0) o << ", \"query\": " << e.queryId;
         switch (e.kind) {
             case Kind::ShaderCall:
                 o << ", \"stage\": " << json::quoted(std::string(dxr::toString(e.stage))) << ", \"export\": " << json::quoted(r.exportName)
@@ -435,6 +481,28 @@ std::string explanationJson(const Explanation& x, const SceneDesc& scene) {
                 if (!r.note.empty()) o << ", \"note\": " << json::quoted(r.note);
                 break;
             case Kind::Skipped: o << ", \"note\": " << json::quoted(r.note); break;
+            case Kind::QueryInit:
+                o << ", \"origin\": " << jsonVec3(e.ray.Origin) << ", \"direction\": " << jsonVec3(e.ray.Direction)
+                  << ", \"tMin\": " << jsonNumber(e.ray.TMin) << ", \"tMax\": " << jsonNumber(e.ray.TMax)
+                  << ", \"rayFlags\": " << e.rayFlags << ", \"effectiveFlags\": " << e.effectiveFlags
+                  << ", \"effectiveFlagNames\": " << json::quoted(dxr::rayFlagsToString(e.effectiveFlags))
+                  << ", \"instanceInclusionMask\": " << e.instanceInclusionMask;
+                break;
+            case Kind::QueryProceed:
+                o << ", \"result\": " << (e.accepted ? "true" : "false") << ", \"t\": " << jsonNumber(e.t);
+                if (e.accepted)
+                    o << ", \"candidateType\": " << json::quoted(e.procedural ? "CANDIDATE_PROCEDURAL_PRIMITIVE" : "CANDIDATE_NON_OPAQUE_TRIANGLE")
+                      << ", \"instanceIndex\": " << e.instanceIndex << ", \"instanceID\": " << e.instanceID
+                      << ", \"geometryIndex\": " << e.geometryIndex << ", \"primitiveIndex\": " << e.primitiveIndex;
+                o << ", \"note\": " << json::quoted(r.note);
+                break;
+            case Kind::QueryCommit:
+                o << ", \"instanceIndex\": " << e.instanceIndex << ", \"instanceID\": " << e.instanceID
+                  << ", \"geometryIndex\": " << e.geometryIndex << ", \"primitiveIndex\": " << e.primitiveIndex
+                  << ", \"procedural\": " << (e.procedural ? "true" : "false") << ", \"t\": " << jsonNumber(e.t)
+                  << ", \"note\": " << json::quoted(r.note);
+                break;
+            case Kind::QueryAbort: o << ", \"committed\": " << (e.committed ? "true" : "false") << ", \"t\": " << jsonNumber(e.t); break;
             case Kind::RecordLookup:
                 o << ", \"table\": " << json::quoted(r.table) << ", \"recordIndex\": " << e.recordIndex
                   << ", \"recordAddress\": " << e.recordAddress << ", \"stride\": " << e.stride

@@ -21,6 +21,7 @@ struct DispatchState {
     DispatchOptions options;
     uint64_t epoch = 0;
     RecordView rayGenRecord;
+    const ShaderExport* computeShader = nullptr;  // Device::dispatch: the compute shader every launch runs
     bool anyHitInPipeline = false;  // a hit group of the pipeline names an any-hit shader
     std::atomic<uint64_t> firstErrorIndex{~0ull};
 };

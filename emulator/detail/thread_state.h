@@ -49,6 +49,7 @@ struct ThreadState {
     DispatchStats stats;
     std::vector<Candidate> candidates;
     uint64_t rayCounter = 0;
+    uint32_t queriesTraced = 0;  // TraceRayInline calls on this launch: numbers RayQuery events
     std::vector<Diagnostic> stopErrors;  // OnError::Stop: the errors that ended a launch
     std::vector<const ShaderExport*> callChain;  // the shaders running on this launch, outermost first
     GpuVirtualAddress lastTlasAddress = 0;  // one-entry cache of the TLAS lookup

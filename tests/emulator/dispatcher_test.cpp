@@ -281,6 +281,10 @@ struct EventLog : TraceObserver {
             case TraceEvent::Kind::AnyHit: s = "AnyHit p" + std::to_string(e.primitiveIndex) + " " + std::string(e.note); break;
             case TraceEvent::Kind::Commit: s = "Commit p" + std::to_string(e.primitiveIndex); break;
             case TraceEvent::Kind::TraceRayEnd: s = e.committed ? "End hit p" + std::to_string(e.primitiveIndex) : "End miss"; break;
+            case TraceEvent::Kind::QueryInit: s = "QueryInit"; break;
+            case TraceEvent::Kind::QueryProceed: s = std::string("Proceed ") + (e.accepted ? "TRUE" : "FALSE"); break;
+            case TraceEvent::Kind::QueryCommit: s = "QueryCommit p" + std::to_string(e.primitiveIndex); break;
+            case TraceEvent::Kind::QueryAbort: s = "Abort"; break;
         }
         std::lock_guard<std::mutex> guard(lock);
         lines.push_back(s);
