@@ -32,6 +32,16 @@ VkStridedDeviceAddressRegionKHR region(VkDeviceAddress base, const ShaderTableRe
     return {base + r.offset, r.stride, r.size};
 }
 
+// The emulator's options that the GPU cannot honour.
+void checkDispatchOptions(const dxr::DispatchOptions& options) {
+    REFRAY_CHECK(!options.region, "the Vulkan back end renders whole dispatches; a launch region (refray explain) is "
+                                  "the emulator's");
+    REFRAY_CHECK(!options.observer, "the Vulkan back end records no trace events (refray explain, --aov on the "
+                                    "emulator); they are the emulator's");
+    REFRAY_CHECK(options.order == dxr::TraversalOrder::Ordered,
+                 "--order adversarial is the emulator's; the GPU traverses in its own order");
+}
+
 }  // namespace
 
 std::filesystem::path defaultSpirvDirectory(const std::filesystem::path& executable) {
@@ -58,13 +68,34 @@ dxr::DispatchResult VulkanBackend::dispatchRays(dxr::Device& device, const dxr::
                                                 const dxr::StateObjectPtr& pipeline,
                                                 const dxr::GlobalRootArguments* globals,
                                                 const dxr::DispatchOptions& options) {
-    REFRAY_CHECK(!options.region, "the Vulkan back end renders whole dispatches; a launch region (refray explain) is "
-                                  "the emulator's");
-    REFRAY_CHECK(!options.observer, "the Vulkan back end records no trace events (refray explain, --aov on the "
-                                    "emulator); they are the emulator's");
-    REFRAY_CHECK(options.order == dxr::TraversalOrder::Ordered,
-                 "--order adversarial is the emulator's; the GPU traverses in its own order");
+    checkDispatchOptions(options);
     return run(device, desc, pipeline, globals, nullptr);
+}
+
+
+ComputeDispatch VulkanBackend::computeDispatchOf(const dxr::DispatchDesc& desc,
+                                                 const dxr::StateObjectPtr& pipeline) const {
+    REFRAY_CHECK(pipeline, "Dispatch on the Vulkan back end needs a state object");
+    const dxr::ShaderExport* shader = pipeline->findComputeShader(desc.ComputeShader);
+    REFRAY_CHECK(shader, "Dispatch: state object '" << pipeline->name() << "' has no compute shader '"
+                                                    << desc.ComputeShader << "'");
+    ComputeDispatch out;
+    out.exportName = shader->name;
+    out.numThreads = {shader->numThreads.x, shader->numThreads.y, shader->numThreads.z};
+    out.groups = {desc.ThreadGroupCountX, desc.ThreadGroupCountY, desc.ThreadGroupCountZ};
+    return out;
+}
+
+dxr::DispatchResult VulkanBackend::dispatch(dxr::Device& device, const dxr::DispatchDesc& desc,
+                                            const dxr::StateObjectPtr& pipeline, const dxr::GlobalRootArguments* globals,
+                                            const dxr::DispatchOptions& options) {
+    checkDispatchOptions(options);
+    return dispatchCompute(device, computeDispatchOf(desc, pipeline), globals);
+}
+
+AovPixels VulkanBackend::dispatchAov(dxr::Device& device, const dxr::DispatchDesc& desc,
+                                     const dxr::StateObjectPtr& pipeline, const dxr::GlobalRootArguments* globals) {
+    return dispatchComputeAov(device, computeDispatchOf(desc, pipeline), globals);
 }
 
 AovPixels VulkanBackend::dispatchAov(dxr::Device& device, const dxr::DispatchRaysDesc& desc,

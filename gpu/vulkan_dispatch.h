@@ -85,12 +85,21 @@ public:
     // export's [numthreads], or it traces inline on a device without ray queries (naming the device).
     dxr::DispatchResult dispatchCompute(dxr::Device& device, const ComputeDispatch& dispatch,
                                         const dxr::GlobalRootArguments* globals);
+    // The same arguments as dxr::Device::dispatch: the state object's compute export `desc.ComputeShader` (its
+    // [numthreads]) and the group counts, run by dispatchCompute. Options the GPU cannot honour throw, as for
+    // dispatchRays; an export the state object does not have throws refray::Error.
+    dxr::DispatchResult dispatch(dxr::Device& device, const dxr::DispatchDesc& desc, const dxr::StateObjectPtr& pipeline,
+                                 const dxr::GlobalRootArguments* globals, const dxr::DispatchOptions& options = {});
+    // dispatch's AOV: each thread's first ray query (dispatchComputeAov).
+    AovPixels dispatchAov(dxr::Device& device, const dxr::DispatchDesc& desc, const dxr::StateObjectPtr& pipeline,
+                          const dxr::GlobalRootArguments* globals);
     // The compute AOV dispatch: <Export>.aov.comp.spv, which records each thread's first ray query's committed hit
     // (gpu/shaders/common/d3d12_ray_query.glsl, REFRAY_AOV_FIRST_QUERY).
     AovPixels dispatchComputeAov(dxr::Device& device, const ComputeDispatch& dispatch,
                                  const dxr::GlobalRootArguments* globals);
 
 private:
+    ComputeDispatch computeDispatchOf(const dxr::DispatchDesc& desc, const dxr::StateObjectPtr& pipeline) const;
     struct BoundGlobals;
     std::unique_ptr<BoundGlobals> bindGlobals(dxr::Device& device, const dxr::GlobalRootArguments& globals,
                                               uint64_t aovValues) const;
