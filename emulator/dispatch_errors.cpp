@@ -18,6 +18,16 @@ void raise(ThreadState& ts, const Site& site, const Diagnostic& d) {
 
 void warn(ThreadState& ts, const Site& site, const Diagnostic& d) { ts.log.add(locate(ts, d, site), ts.linearIndex); }
 
+void foldNotes(ThreadState& ts) {
+    for (NoteTally& tally : ts.queryNotes)
+        if (tally.more) {
+            Diagnostic d = tally.first;
+            d.count = tally.more;
+            ts.log.add(d, ~0ull);
+            tally.more = 0;
+        }
+}
+
 void stageError(Invocation& inv, const char* rule, const std::string& message) {
     throw DxrError(locate(*inv.thread, diag(rule, message).value("stage", toString(inv.stage)), siteOf(inv)));
 }

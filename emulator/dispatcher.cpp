@@ -190,6 +190,7 @@ DispatchStats finishedStats(const ThreadState& ts) {
 void collectResults(ThreadStates& threadStates, const DispatchRaysDesc& desc, DispatchResult& result) {
     std::vector<Diagnostic> errors;
     for (auto& ts : threadStates) {
+        detail::foldNotes(ts);
         result.diagnostics.merge(ts.log);
         result.stats.merge(finishedStats(ts));
         errors.insert(errors.end(), ts.stopErrors.begin(), ts.stopErrors.end());

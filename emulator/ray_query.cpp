@@ -2,6 +2,7 @@
 // getters, each checked against the specification's tables (RQ-19), with trace events for `refray explain`.
 #include "emulator/ray_query.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -90,14 +91,18 @@ DiagnosticBuilder stateDiag(const RayQueryState& q, const char* rule, const std:
 
 void raiseQuery(const RayQueryState& q, const Diagnostic& d) { raise(threadOf(q), siteOf(*q.inv), d); }
 
-// A use DXR defines and SPIR-V does not (18e): a note, once per rule and call in the dispatch's log.
-void spirvNote(const RayQueryState& q, const char* rule, const std::string& what) {
-    Diagnostic d = DiagnosticBuilder(rule, what + ": defined in DXR, undefined in SPIR-V (a Vulkan port must guard it; "
-                                           "dxr-semantics.md 18e)",
-                                     Severity::Note)
-                       .value("query", q.id)
-                       .value("state", phaseName(q.phase));
-    warn(threadOf(q), siteOf(*q.inv), d);
+// A use DXR defines and SPIR-V does not (18e): a note, counted per kind (NoteTally).
+enum class SpirvUndefined : uint8_t { ProceedAfterFalse, AbortWithoutCandidate, CommittedRayTOfNothing };
+
+void spirvNote(const RayQueryState& q, SpirvUndefined kind, const char* rule, const char* what) {
+    ThreadState& ts = threadOf(q);
+    note(ts, siteOf(*q.inv), ts.queryNotes[size_t(kind)], [&] {
+        return Diagnostic(DiagnosticBuilder(rule,
+                                            std::string(what) + ": defined in DXR, undefined in SPIR-V (a Vulkan port "
+                                                                "must guard it; dxr-semantics.md 18e)",
+                                            Severity::Note)
+                              .value("state", phaseName(q.phase)));
+    });
 }
 
 TraceEvent queryEvent(const RayQueryState& q, TraceEvent::Kind kind) {
@@ -219,6 +224,12 @@ RayQueryObject::RayQueryObject(ShaderContext& ctx, uint32_t templateRayFlags, ui
     state_->templateFlags = templateRayFlags;
     state_->rayQueryFlags = rayQueryFlags;
     ctx.requireLive("RayQuery");
+    const ShaderExport* shader = ctx.inv_.shader;
+    if (shader && std::find(shader->rayQueryFlags.begin(), shader->rayQueryFlags.end(), templateRayFlags) ==
+                      shader->rayQueryFlags.end())
+        detail::stageError(ctx.inv_, "RQ-2",
+                           "shader '" + shader->name + "' makes a RayQuery<" + rayFlagsToString(templateRayFlags) +
+                               "> that its export does not declare (ShaderLibrary::declareRayQueries)");
 }
 
 void RayQueryObject::TraceRayInline(GpuVirtualAddress as, uint32_t rayFlags, uint32_t mask, const RayDesc& ray) {
@@ -286,7 +297,8 @@ bool RayQueryObject::Proceed() {
         detail::raiseQuery(q, detail::stateDiag(q, "RQ-19", "Proceed", "was called before TraceRayInline"));
     } else if (q.phase == QueryPhase::Finished) {
         // RQ-12: FALSE again, and nothing happens; SPIR-V leaves it undefined.
-        detail::spirvNote(q, "RQ-12", "Proceed() after it returned FALSE (or after Abort)");
+        detail::spirvNote(q, detail::SpirvUndefined::ProceedAfterFalse, "RQ-12",
+                          "Proceed() after it returned FALSE (or after Abort)");
     } else {
         q.proceeded = true;
         result = detail::advance(q);
@@ -314,7 +326,8 @@ void RayQueryObject::Abort() {
         return;
     }
     if (q.phase != QueryPhase::Candidate)  // RQ-15: legal in DXR; SPIR-V needs a TRUE Proceed just before
-        detail::spirvNote(q, "RQ-15", "Abort() without a Proceed() that returned TRUE just before");
+        detail::spirvNote(q, detail::SpirvUndefined::AbortWithoutCandidate, "RQ-15",
+                          "Abort() without a Proceed() that returned TRUE just before");
     q.phase = QueryPhase::Finished;
     detail::ThreadState& ts = detail::threadOf(q);
     if (detail::observer(ts)) {
@@ -503,7 +516,8 @@ float RayQueryObject::CommittedRayT() const {
     const RayQueryState& q = *state_;
     checkQueryGetter(q, "CommittedRayT");
     if (q.status == COMMITTED_NOTHING && q.phase != QueryPhase::Fresh)  // RQ-27: TMax
-        detail::spirvNote(q, "RQ-27", "CommittedRayT() with COMMITTED_NOTHING (DXR: TMax)");
+        detail::spirvNote(q, detail::SpirvUndefined::CommittedRayTOfNothing, "RQ-27",
+                          "CommittedRayT() with COMMITTED_NOTHING (DXR: TMax)");
     return q.rs.tCurrent;
 }
 uint32_t RayQueryObject::CommittedInstanceIndex() const {

@@ -50,6 +50,12 @@ void ShaderLibrary::addCompute(std::string name, uvec3 numThreads, std::function
     add(std::move(e));
 }
 
+void ShaderLibrary::declareRayQueries(const std::string& name, std::vector<uint32_t> templateRayFlags) {
+    auto it = exports_.find(name);
+    REFRAY_CHECK(it != exports_.end(), "declareRayQueries: the library has no export '" << name << "'");
+    it->second.rayQueryFlags = std::move(templateRayFlags);
+}
+
 void ShaderLibrary::add(ShaderExport e) {
     REFRAY_CHECK(!e.name.empty(), "a shader export needs a name");
     REFRAY_CHECK(e.function, "shader export '" << e.name << "' has no function");

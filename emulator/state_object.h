@@ -62,6 +62,9 @@ struct ShaderExport {
     ErasedShader function;
     ReportHitEnd reportHitEnd = ReportHitEnd::Unwind;  // IS
     uvec3 numThreads{1u};  // compute: [numthreads(x, y, z)]
+    // The RayQuery objects the shader's code declares (RQ-2), by their template ray flags, in source order: what
+    // DXIL records and `refray table` shows. A shader that makes a RayQuery it does not declare stops with RQ-2.
+    std::vector<uint32_t> rayQueryFlags = {};
 };
 
 // A DXIL library: named shader exports. Signatures mirror HLSL entry points:
@@ -103,6 +106,9 @@ public:
         add({std::move(name), ShaderStage::Callable, {}, {}, typeTag<Parameters>(),
              [fn = std::move(fn)](ShaderContext& c, void* p, const void*) { fn(c, *static_cast<Parameters*>(p)); }});
     }
+
+    // Records that export `name` declares RayQuery objects with these template ray flags (ShaderExport::rayQueryFlags).
+    void declareRayQueries(const std::string& name, std::vector<uint32_t> templateRayFlags);
 
     const std::map<std::string, ShaderExport>& exports() const { return exports_; }
     const ShaderExport* find(const std::string& name) const;

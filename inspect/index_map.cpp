@@ -32,6 +32,18 @@ class PixelRecorder : public dxr::TraceObserver {
 public:
     PixelRecorder(uint32_t width, uint32_t height) : width_(width), pixels_(size_t(width) * height) {}
     void onEvent(const TraceEvent& e) override {
+        if (e.queryId == 1 && e.stage == dxr::ShaderStage::Compute) {  // a compute scene: its first RayQuery
+            PrimaryHit& p = pixels_[size_t(e.launchIndex.y) * width_ + e.launchIndex.x];
+            if (e.kind == TraceEvent::Kind::QueryInit) p.traced = true;
+            if (e.kind == TraceEvent::Kind::QueryCommit) {  // the last commit is the committed hit
+                p.hit = true;
+                p.instanceIndex = e.instanceIndex;
+                p.geometryIndex = e.geometryIndex;
+                p.primitiveIndex = e.primitiveIndex;
+                p.instanceID = e.instanceID;
+            }
+            return;
+        }
         if (e.kind != TraceEvent::Kind::TraceRay && e.kind != TraceEvent::Kind::TraceRayEnd) return;
         const size_t i = size_t(e.launchIndex.y) * width_ + e.launchIndex.x;
         PrimaryHit& p = pixels_[i];
@@ -103,6 +115,10 @@ IndexMap renderIndexMap(Scene& scene, const RenderSettings& settings, IndexMapKi
 
 IndexMap indexMapOf(const SceneDesc& desc, uint32_t width, uint32_t height, IndexMapKind kind,
                     const std::vector<PrimaryHit>& pixels) {
+    REFRAY_CHECK(desc.computeShader.empty() || (kind != IndexMapKind::Record && kind != IndexMapKind::HitGroup),
+                 "scene '" << desc.name << "' renders with the compute shader '" << desc.computeShader
+                           << "': its primary rays are RayQuery objects, which read no shader record (RQ-31); "
+                              "the instance, geometry, primitive and depth maps apply");
     REFRAY_CHECK(pixels.size() == size_t(width) * height,
                  "an index map of " << width << "x" << height << " needs " << size_t(width) * height
                                     << " primary hits, got " << pixels.size());

@@ -25,6 +25,11 @@ using DispatchBackend =
     std::function<dxr::DispatchResult(dxr::Device&, const dxr::DispatchRaysDesc&, const dxr::StateObjectPtr&,
                                       const dxr::GlobalRootArguments*, const dxr::DispatchOptions&)>;
 
+// Where a compute dispatch runs (scenes whose pipeline names "compute": Device::dispatch's arguments).
+using ComputeBackend =
+    std::function<dxr::DispatchResult(dxr::Device&, const dxr::DispatchDesc&, const dxr::StateObjectPtr&,
+                                      const dxr::GlobalRootArguments*, const dxr::DispatchOptions&)>;
+
 struct RenderSettings {
     uint32_t width = 640;
     uint32_t height = 360;
@@ -60,12 +65,14 @@ struct RenderSettings {
     bool specialise = true;
     // Empty: the emulator runs the dispatch (dxr::Device::dispatchRays).
     DispatchBackend backend;
+    // The same for a compute dispatch (dxr::Device::dispatch). A render with `backend` set and this empty refuses
+    // a compute scene rather than running it on the emulator.
+    ComputeBackend computeBackend;
 };
 
-// Runs DispatchRays for a width x height dispatch with the settings' threads, order, error mode and progress.
-inline dxr::DispatchResult dispatchWithSettings(dxr::Device& device, const dxr::DispatchRaysDesc& desc,
-                                                const dxr::StateObjectPtr& pipeline, const dxr::GlobalRootArguments* globals,
-                                                const RenderSettings& settings) {
+// The DispatchOptions of the settings; `progress` receives `launches` when the settings have a progress sink.
+inline dxr::DispatchOptions dispatchOptions(const RenderSettings& settings, uint64_t launches,
+                                           std::unique_ptr<Progress>& progress) {
     dxr::DispatchOptions options;
     options.threads = settings.threads;
     options.order = settings.order;
@@ -75,15 +82,40 @@ inline dxr::DispatchResult dispatchWithSettings(dxr::Device& device, const dxr::
     options.observer = settings.observer;
     options.profileStages = settings.profileStages;
     options.specialise = settings.specialise;
-    std::unique_ptr<Progress> progress;
     if (settings.progress) {
-        const uint64_t launches = settings.region ? uint64_t(settings.region->width) * settings.region->height * desc.Depth
-                                                  : uint64_t(desc.Width) * desc.Height * desc.Depth;
+        if (settings.region) launches = uint64_t(settings.region->width) * settings.region->height;
         progress = std::make_unique<Progress>("render", launches, settings.progress);
         options.progress = progress.get();
     }
+    return options;
+}
+
+// Runs DispatchRays for a width x height dispatch with the settings' threads, order, error mode and progress.
+inline dxr::DispatchResult dispatchWithSettings(dxr::Device& device, const dxr::DispatchRaysDesc& desc,
+                                                const dxr::StateObjectPtr& pipeline, const dxr::GlobalRootArguments* globals,
+                                                const RenderSettings& settings) {
+    std::unique_ptr<Progress> progress;
+    const dxr::DispatchOptions options =
+        dispatchOptions(settings, uint64_t(desc.Width) * desc.Height * desc.Depth, progress);
     dxr::DispatchResult result = settings.backend ? settings.backend(device, desc, pipeline, globals, options)
                                                   : device.dispatchRays(desc, pipeline, globals, options);
+    if (progress) progress->finish();
+    return result;
+}
+
+// Runs a compute dispatch of `threads` (the grid of SV_DispatchThreadID) the same way.
+inline dxr::DispatchResult dispatchComputeWithSettings(dxr::Device& device, const dxr::DispatchDesc& desc, uvec3 threads,
+                                                       const dxr::StateObjectPtr& pipeline,
+                                                       const dxr::GlobalRootArguments* globals,
+                                                       const RenderSettings& settings) {
+    REFRAY_CHECK(!settings.backend || settings.computeBackend,
+                 "this device runs DispatchRays but has no compute back end for the compute shader '"
+                     << desc.ComputeShader << "'");
+    std::unique_ptr<Progress> progress;
+    const dxr::DispatchOptions options = dispatchOptions(settings, uint64_t(threads.x) * threads.y * threads.z, progress);
+    dxr::DispatchResult result = settings.computeBackend
+                                     ? settings.computeBackend(device, desc, pipeline, globals, options)
+                                     : device.dispatch(desc, pipeline, globals, options);
     if (progress) progress->finish();
     return result;
 }

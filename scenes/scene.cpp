@@ -352,12 +352,22 @@ RenderResult Scene::render(const RenderSettings& settings) {
         }
     }
 
-    DispatchRaysDesc desc = pipeline.tables;
-    desc.Width = width;
-    desc.Height = height;
-    desc.Depth = 1;
     RenderResult result;
-    result.dispatch = dispatchWithSettings(device_, desc, pipeline.stateObject, &globals, settings);
+    if (!desc_.computeShader.empty()) {  // one thread per pixel, in groups of the shader's numthreads
+        const dxr::ShaderExport* cs = pipeline.stateObject->findComputeShader(desc_.computeShader);
+        REFRAY_CHECK(cs, "the state object has no compute shader '" << desc_.computeShader << "'");
+        const uvec3 n = cs->numThreads;
+        const DispatchDesc dispatch{desc_.computeShader, (width + n.x - 1) / n.x, (height + n.y - 1) / n.y, 1};
+        result.dispatch = dispatchComputeWithSettings(
+            device_, dispatch, uvec3(dispatch.ThreadGroupCountX * n.x, dispatch.ThreadGroupCountY * n.y, n.z),
+            pipeline.stateObject, &globals, settings);
+    } else {
+        DispatchRaysDesc desc = pipeline.tables;
+        desc.Width = width;
+        desc.Height = height;
+        desc.Depth = 1;
+        result.dispatch = dispatchWithSettings(device_, desc, pipeline.stateObject, &globals, settings);
+    }
     reportNonFinitePixels(target, settings, result.dispatch.diagnostics);
 
     // k x k samples per output pixel, averaged in float in a fixed order (deterministic).

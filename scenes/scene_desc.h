@@ -207,6 +207,10 @@ struct SceneDesc {
     std::vector<StructDesc> structs;  // the file's "structs", in file order
 
     // Pipeline.
+    // "compute": the scene renders with Device::dispatch of this compute export (inline tracing), one thread per
+    // pixel in groups of its numthreads; the ray-tracing pipeline is still built (what `refray table` shows) but
+    // none of its tables is read. Empty: DispatchRays of `rayGeneration`.
+    std::string computeShader;
     std::string rayGeneration;
     uint32_t maxRecursionDepth = 1;
     uint32_t maxPayloadBytes = 0;

@@ -12,12 +12,18 @@ namespace {
 
 constexpr const char* kNamesKey = "object_names";
 
-// Keeps each pixel's first primary ray's committed hit. Each launch index is written by one thread only.
+// Keeps each pixel's first primary ray's committed hit: the first TraceRay of depth 1, or in a compute scene the
+// first RayQuery of the thread (its last commit is its committed hit). Each launch index is written by one thread.
 class PrimaryObjectRecorder : public dxr::TraceObserver {
 public:
     PrimaryObjectRecorder(uint32_t width, uint32_t height)
         : width_(width), ids_(size_t(width) * height, -1), done_(ids_.size(), 0) {}
     void onEvent(const dxr::TraceEvent& e) override {
+        if (e.kind == dxr::TraceEvent::Kind::QueryCommit && e.queryId == 1 && e.stage == dxr::ShaderStage::Compute) {
+            const size_t i = size_t(e.launchIndex.y) * width_ + e.launchIndex.x;
+            if (i < ids_.size()) ids_[i] = objectId(e.instanceIndex, e.geometryIndex);
+            return;
+        }
         if (e.kind != dxr::TraceEvent::Kind::TraceRayEnd || e.depth != 1) return;
         const size_t i = size_t(e.launchIndex.y) * width_ + e.launchIndex.x;
         if (i >= ids_.size() || done_[i]) return;

@@ -11,6 +11,7 @@
 namespace refray::dxr::detail {
 
 struct ThreadState;
+struct NoteTally;
 
 // Where a diagnostic arises: the stage, export and depth of the invocation that raises it.
 struct Site {
@@ -34,8 +35,30 @@ void raise(ThreadState& ts, const Site& site, const Diagnostic& d);
 
 void warn(ThreadState& ts, const Site& site, const Diagnostic& d);
 
+// A note counted in `tally` (NoteTally): logged in full only when it is the thread's first or comes from a smaller
+// launch index than the one logged, so repeating it costs a counter. `make` builds the diagnostic.
+template <class Make>
+void note(ThreadState& ts, const Site& site, NoteTally& tally, Make make);
+
+// Adds the counts `note` kept back to the thread's log; called once when the dispatch ends.
+void foldNotes(ThreadState& ts);
+
 // Stops the invocation with a DxrError carrying `rule`, the stage and the launch site: misuse of the shader API
 // always stops, there is no fallback.
 [[noreturn]] void stageError(Invocation& inv, const char* rule, const std::string& message);
 
 }  // namespace refray::dxr::detail
+
+#include "emulator/detail/thread_state.h"
+
+template <class Make>
+void refray::dxr::detail::note(ThreadState& ts, const Site& site, NoteTally& tally, Make make) {
+    if (tally.logged && ts.linearIndex >= tally.orderKey) {
+        ++tally.more;
+        return;
+    }
+    tally.logged = true;
+    tally.orderKey = ts.linearIndex;
+    tally.first = locate(ts, make(), site);
+    ts.log.add(tally.first, ts.linearIndex);
+}

@@ -41,6 +41,15 @@ struct ExportCount {
     uint64_t count = 0;
 };
 
+// A note (Severity::Note) a dispatch may repeat millions of times (a RayQuery's SPIR-V-undefined uses): the log gets
+// the occurrence with the smallest launch index this thread met, `more` counts the rest until foldNotes.
+struct NoteTally {
+    bool logged = false;
+    uint64_t orderKey = 0;
+    uint64_t more = 0;
+    Diagnostic first;
+};
+
 struct ThreadState {
     DispatchState* dispatch = nullptr;
     uvec3 launchIndex{0u};
@@ -50,6 +59,7 @@ struct ThreadState {
     std::vector<Candidate> candidates;
     uint64_t rayCounter = 0;
     uint32_t queriesTraced = 0;  // TraceRayInline calls on this launch: numbers RayQuery events
+    std::array<NoteTally, 3> queryNotes;  // ray_query.cpp: Proceed after FALSE, Abort, CommittedRayT with nothing
     std::vector<Diagnostic> stopErrors;  // OnError::Stop: the errors that ended a launch
     std::vector<const ShaderExport*> callChain;  // the shaders running on this launch, outermost first
     GpuVirtualAddress lastTlasAddress = 0;  // one-entry cache of the TLAS lookup

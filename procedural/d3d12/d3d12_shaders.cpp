@@ -229,21 +229,26 @@ tvec3<T> HitWorldPosition(const ShaderContext& ctx) {
 
 // The object ray in the primitive's local space. The direction is not renormalised, so t means the same in world,
 // object and local space (§2.2).
+// PORT: the object-space ray is a parameter, so that a RayQuery's candidate ray goes the same way.
+template <typename T>
+math::Ray<T> GetRayInAABBPrimitiveLocalSpace(vec3 objectRayOrigin, vec3 objectRayDirection,
+                                             const PrimitiveInstancePerFrameBuffer& attr) {
+    math::Ray<T> ray;
+    ray.origin = tvec3<T>(mul(tvec4<T>(tvec3<T>(objectRayOrigin), T(1)), attr.bottomLevelASToLocalSpace));
+    ray.direction = mul3x3(tvec3<T>(objectRayDirection), attr.bottomLevelASToLocalSpace);
+    return ray;
+}
 template <typename T>
 math::Ray<T> GetRayInAABBPrimitiveLocalSpace(const ShaderContext& ctx, const PrimitiveInstancePerFrameBuffer& attr) {
-    math::Ray<T> ray;
-    ray.origin = tvec3<T>(mul(tvec4<T>(tvec3<T>(ctx.ObjectRayOrigin()), T(1)), attr.bottomLevelASToLocalSpace));
-    ray.direction = mul3x3(tvec3<T>(ctx.ObjectRayDirection()), attr.bottomLevelASToLocalSpace);
-    return ray;
+    return GetRayInAABBPrimitiveLocalSpace<T>(ctx.ObjectRayOrigin(), ctx.ObjectRayDirection(), attr);
 }
 
 // mul(n, (float3x3)localSpaceToBottomLevelAS), then normalize(mul((float3x3)ObjectToWorld3x4(), n)): the forward
 // matrix, not the inverse transpose (I1).
+// PORT: ObjectToWorld3x4() is a parameter (a RayQuery's candidate matrix, or the intersection shader's).
 template <typename T>
-tvec3<T> NormalToWorld(const ShaderContext& ctx, const PrimitiveInstancePerFrameBuffer& attr,
-                       const tvec3<T>& localNormal) {
+tvec3<T> NormalToWorld(const Matrix3x4& o2w, const PrimitiveInstancePerFrameBuffer& attr, const tvec3<T>& localNormal) {
     const tvec3<T> n = mul3x3(localNormal, attr.localSpaceToBottomLevelAS);
-    const Matrix3x4 o2w = ctx.ObjectToWorld3x4();
     tvec3<T> r;
     for (int i = 0; i < 3; ++i) r[i] = T(o2w.m[i][0]) * n.x + T(o2w.m[i][1]) * n.y + T(o2w.m[i][2]) * n.z;
     return hlsl::normalize(r);
@@ -251,10 +256,65 @@ tvec3<T> NormalToWorld(const ShaderContext& ctx, const PrimitiveInstancePerFrame
 
 // The sample applies the triangle culling flags to its procedural hits itself (I3).
 template <typename T>
-math::RayExtent<T> CurrentExtent(const ShaderContext& ctx) {
-    const uint32_t flags = ctx.RayFlags();
-    return {T(ctx.RayTMin()), T(ctx.RayTCurrent()), (flags & RAY_FLAG_CULL_BACK_FACING_TRIANGLES) != 0,
+math::RayExtent<T> CurrentExtent(float tMin, float tCurrent, uint32_t flags) {
+    return {T(tMin), T(tCurrent), (flags & RAY_FLAG_CULL_BACK_FACING_TRIANGLES) != 0,
             (flags & RAY_FLAG_CULL_FRONT_FACING_TRIANGLES) != 0};
+}
+template <typename T>
+math::RayExtent<T> CurrentExtent(const ShaderContext& ctx) {
+    return CurrentExtent<T>(ctx.RayTMin(), ctx.RayTCurrent(), ctx.RayFlags());
+}
+
+// The three intersection shaders' tests (RayAnalyticGeometryIntersectionTest, RayVolumetricGeometryIntersectionTest,
+// RaySignedDistancePrimitiveTest) on the primitive's local ray inside `extent`: shared by the intersection shaders
+// and the inline-tracing shaders, which intersect their procedural candidates themselves (scenes/inline/).
+enum class IntersectionShader : uint32_t { AnalyticPrimitive = 0, VolumetricPrimitive = 1, SignedDistancePrimitive = 2 };
+
+template <typename T>
+struct PrimitiveHit {
+    bool hit = false;
+    T thit = T(0);
+    tvec3<T> normal{T(0)};  // local space
+};
+
+template <typename T>
+PrimitiveHit<T> IntersectPrimitive(IntersectionShader shader, uint32_t primitiveType, const math::Ray<T>& localRay,
+                                   const math::RayExtent<T>& extent, T elapsedTime, T stepScale,
+                                   const Accuracy& accuracy) {
+    switch (shader) {
+        case IntersectionShader::AnalyticPrimitive: {
+            // RayAnalyticGeometryIntersectionTest: the local box is <-1,1>^3.
+            math::AnalyticHit<T> test;
+            switch (AnalyticPrimitive::Enum(primitiveType)) {
+                case AnalyticPrimitive::AABB: test = math::RayUnitCubeIntersectionTest(localRay, extent); break;
+                case AnalyticPrimitive::Spheres: test = math::RaySpheresIntersectionTest(localRay, extent); break;
+                default: break;
+            }
+            return {test.hit, test.thit, test.normal};
+        }
+        case IntersectionShader::VolumetricPrimitive: {
+            // RayVolumetricGeometryIntersectionTest: metaballs animated over a 12 s cycle. The march step depends on
+            // the extent's tCurrent at call time (H10).
+            // PORT: the sample count and the normal's step come from the library's Accuracy.
+            math::MetaballsHit<T> test;
+            if (VolumetricPrimitive::Enum(primitiveType) == VolumetricPrimitive::Metaballs)
+                test = math::RayMetaballsIntersectionTest(localRay, extent, elapsedTime, T(12),
+                                                          metaballsParams<T>(accuracy));
+            return {test.hit, test.thit, test.normal};
+        }
+        case IntersectionShader::SignedDistancePrimitive: {
+            // RaySignedDistancePrimitiveTest: sphere tracing from the extent's tMin, not from the box entry (I6).
+            // PORT: the threshold, step limit and normal offset come from the library's Accuracy.
+            const math::SphereTraceParams<T> params = sphereTraceParams(accuracy, stepScale);
+            const auto sdf = [primitiveType](const tvec3<T>& position) {
+                return math::d3d12::GetDistanceFromSignedDistancePrimitive(position,
+                                                                           SignedDistancePrimitive(primitiveType));
+            };
+            const math::SphereTraceResult<T> test = math::RaySignedDistancePrimitiveTest(localRay, extent, sdf, params);
+            return {test.hit, test.thit, test.normal};
+        }
+    }
+    return {};
 }
 
 // TraceRay wrappers: both stop at MAX_RAY_RECURSION_DEPTH (black / "not in shadow"); TMin 0, TMax 10000.
@@ -297,14 +357,89 @@ bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet&
     return shadowPayload.hit != 0;
 }
 
+// ---- Inline tracing (scenes/inline/InlineShadows.hlsl, InlineAmbientOcclusion.hlsl) -------------------
+
+// StructuredBuffer<InlinePrimitive> g_inlinePrimitives : register(t4): per geometry of the AABB BLAS, what the
+// records' local root arguments give the intersection shaders in the TraceRay version.
+struct InlinePrimitive {
+    uint32_t intersectionShader;  // IntersectionShader
+    uint32_t instanceIndex;       // l_aabbCB.instanceIndex
+    uint32_t primitiveType;       // l_aabbCB.primitiveType
+    float stepScale;              // l_materialCB.stepScale
+};
+static_assert(sizeof(InlinePrimitive) == 16);
+inline constexpr uint32_t kInlinePrimitivesRegister = 4;  // t4, space0
+
+// The query flags of TraceShadowRayInlineAndReportIfHit and TraceOcclusionInline: the TraceRay shadow ray's flags
+// less SKIP_CLOSEST_HIT_SHADER, which a RayQuery may not carry (RQ-4).
+inline constexpr uint32_t kInlineShadowQueryFlags =
+    RAY_FLAG_CULL_BACK_FACING_TRIANGLES | RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH;
+// TracePrimaryInline's: the radiance rays' flags.
+inline constexpr uint32_t kInlinePrimaryQueryFlags = RAY_FLAG_CULL_BACK_FACING_TRIANGLES;
+
+// IntersectCandidateProceduralPrimitive: the intersection shaders' code for the query's current procedural
+// candidate, with the query's extent: RayTMin() -> q.RayTMin(), RayTCurrent() -> q.CommittedRayT(), RayFlags() ->
+// q.RayFlags() (a closest hit's own intrinsics describe its own ray). Returns true with t and the world normal.
+template <typename T>
+bool IntersectCandidateProceduralPrimitive(const ShaderContext& ctx, const RayQueryObject& q, const Accuracy& accuracy,
+                                           T& thit, tvec3<T>& normal) {
+    const InlinePrimitive primitive =
+        ctx.loadStructured<InlinePrimitive>(kInlinePrimitivesRegister, 0, 0, q.CandidateGeometryIndex());
+    const PrimitiveInstancePerFrameBuffer aabbAttribute = ctx.load<PrimitiveInstancePerFrameBuffer>(
+        ctx.globalRootDescriptor(kAABBattributeBuffer) +
+        uint64_t(primitive.instanceIndex) * sizeof(PrimitiveInstancePerFrameBuffer));
+    const math::Ray<T> localRay =
+        GetRayInAABBPrimitiveLocalSpace<T>(q.CandidateObjectRayOrigin(), q.CandidateObjectRayDirection(), aabbAttribute);
+    const auto shader = IntersectionShader(primitive.intersectionShader);
+    const T elapsedTime = shader == IntersectionShader::VolumetricPrimitive ? T(sceneCB(ctx).elapsedTime) : T(0);
+    const PrimitiveHit<T> test =
+        IntersectPrimitive<T>(shader, primitive.primitiveType, localRay,
+                              CurrentExtent<T>(q.RayTMin(), q.CommittedRayT(), q.RayFlags()), elapsedTime,
+                              T(primitive.stepScale), accuracy);
+    if (!test.hit) return false;
+    thit = test.thit;
+    normal = NormalToWorld(q.CandidateObjectToWorld3x4(), aabbAttribute, test.normal);
+    return true;
+}
+
+// TraceShadowRayAndReportIfHit, traced inline: procedural candidates are intersected here and committed; the ground
+// plane's triangles are opaque (FORCE_OPAQUE) and committed inside Proceed (RQ-14).
+template <typename T>
+bool TraceShadowRayInlineAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
+                                        const Effects& effects, const Accuracy& accuracy, const tvec3<T>& origin,
+                                        const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
+    if (currentRayRecursionDepth >= maxDepth) return false;
+    if (!kShadowMachinery || !effects.traceShadowRays) return false;  // PORT: shadows switched off (procedural/effects.h)
+    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
+    RayQuery<kInlineShadowQueryFlags> q(ctx);
+    // PORT: TraceRayParameters::InstanceMask is the library's shadow-ray mask, as in the TraceRay version.
+    q.TraceRayInline(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_NONE,
+                     traceRay[RayType::Shadow].instanceInclusionMask, rayDesc);
+    while (q.Proceed()) {
+        if (q.CandidateType() == CANDIDATE_PROCEDURAL_PRIMITIVE) {
+            T thit;
+            tvec3<T> normal;
+            if (IntersectCandidateProceduralPrimitive<T>(ctx, q, accuracy, thit, normal))
+                q.CommitProceduralPrimitiveHit(float(thit));  // ACCEPT_FIRST_HIT_AND_END_SEARCH: Proceed returns FALSE
+        }
+    }
+    return q.CommittedStatus() != COMMITTED_NOTHING;
+}
+
+// How a closest hit traces its shadow ray: TraceRay (the sample) or a RayQuery (InlineShadows.hlsl).
+enum class ShadowTracing : uint8_t { TraceRay, Inline };
+
 // The shadow ray both closest hits start with: from HitWorldPosition() towards the light.
 template <typename T>
 bool TraceShadowRayTowardsLight(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
-                                const Effects& effects, const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth) {
+                                const Effects& effects, const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth,
+                                ShadowTracing tracing, const Accuracy& accuracy) {
     const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
-    return TraceShadowRayAndReportIfHit(ctx, traceRay, maxDepth, effects, hitPosition,
-                                        hlsl::normalize(tvec3<T>(vec3(g_sceneCB.lightPosition)) - hitPosition),
-                                        recursionDepth);
+    const tvec3<T> toLight = hlsl::normalize(tvec3<T>(vec3(g_sceneCB.lightPosition)) - hitPosition);
+    if (tracing == ShadowTracing::Inline)
+        return TraceShadowRayInlineAndReportIfHit(ctx, traceRay, maxDepth, effects, accuracy, hitPosition, toLight,
+                                                  recursionDepth);
+    return TraceShadowRayAndReportIfHit(ctx, traceRay, maxDepth, effects, hitPosition, toLight, recursionDepth);
 }
 
 // reflectanceCoef·(Fresnel, 1)·(reflection ray colour), the reflection ray leaving HitWorldPosition().
@@ -341,7 +476,8 @@ void MyRaygenShader(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, con
 
 template <typename T>
 void MyClosestHitShader_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                                 const Effects& effects, RayPayload& rayPayload, const BuiltInTriangleIntersectionAttributes&) {
+                                 const Effects& effects, RayPayload& rayPayload, const BuiltInTriangleIntersectionAttributes&,
+                                 ShadowTracing tracing) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
@@ -361,7 +497,8 @@ void MyClosestHitShader_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& 
     // Shadow component.
     const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
     const bool shadowRayHit =
-        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, effects, g_sceneCB, rayPayload.recursionDepth);
+        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, effects, g_sceneCB, rayPayload.recursionDepth, tracing,
+                                      accuracy);
 
     // Grid lines from the primary camera rays' footprint, even for secondary hits (I7, H4).
     const T checkers = AnalyticalCheckersTexture(
@@ -385,7 +522,8 @@ void MyClosestHitShader_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& 
 
 template <typename T>
 void MyClosestHitShader_AABB(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                             const Effects& effects, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
+                             const Effects& effects, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr,
+                             ShadowTracing tracing) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
     const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
@@ -393,7 +531,8 @@ void MyClosestHitShader_AABB(ShaderContext& ctx, const TraceRayArgumentSet& trac
 
     const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
     const bool shadowRayHit =
-        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, effects, g_sceneCB, rayPayload.recursionDepth);
+        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, effects, g_sceneCB, rayPayload.recursionDepth, tracing,
+                                      accuracy);
 
     tvec4<T> reflectedColor(T(0));
     if (l_materialCB.reflectanceCoef > 0.001f)
@@ -411,66 +550,142 @@ void MyMissShader(ShaderContext&, RayPayload& rayPayload) { rayPayload.color = B
 
 void MyMissShader_ShadowRay(ShaderContext&, ShadowRayPayload& rayPayload) { rayPayload.hit = 0; }
 
+// ---- InlineAmbientOcclusionCS (scenes/inline/InlineAmbientOcclusion.hlsl) ------------------------------
+
+inline constexpr uint32_t AO_RAY_COUNT = 8;
+inline constexpr float AO_RADIUS = 3.0f;
+inline constexpr float AO_ORIGIN_OFFSET = 0.01f;  // along the normal, in world units
+
+// Chris Wellons' "lowbias32" integer hash.
+uint32_t Hash(uint32_t x) {
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+}
+
+// The top 24 bits of h as a float in [0, 1): exact.
+float UnitFloat(uint32_t h) { return float(h >> 8) * (1.0f / 16777216.0f); }
+
+// The cosine-weighted hemisphere around n, in the orthonormal basis of Duff et al. (JCGT 2017).
+template <typename T>
+tvec3<T> CosineHemisphereDirection(const tvec3<T>& n, T u1, T u2) {
+    const T s = n.z >= T(0) ? T(1) : T(-1);
+    const T a = T(-1) / (s + n.z);
+    const T b = n.x * n.y * a;
+    const tvec3<T> t1(T(1) + s * n.x * n.x * a, s * b, -s * n.x);
+    const tvec3<T> t2(b, s + n.y * n.y * a, -n.y);
+    const T r = hlsl::sqrt(u1);
+    const T phi = T(2) * T(3.14159265f) * u2;
+    return r * hlsl::cos(phi) * t1 + r * hlsl::sin(phi) * t2 + hlsl::sqrt(T(1) - u1) * n;
+}
+
+// The primary query: the closest surface and its world normal, as the sample's closest hits compute it. The system
+// keeps no attributes of a procedural hit (RQ-23): the shader keeps the normal of the hit it commits.
+template <typename T>
+bool TracePrimaryInline(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                        const tvec3<T>& origin, const tvec3<T>& direction, tvec3<T>& hitPosition, tvec3<T>& normal) {
+    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
+    tvec3<T> committedNormal(T(0));
+    RayQuery<kInlinePrimaryQueryFlags> q(ctx);
+    q.TraceRayInline(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_NONE,
+                     traceRay[RayType::Radiance].instanceInclusionMask, rayDesc);
+    while (q.Proceed()) {
+        if (q.CandidateType() == CANDIDATE_PROCEDURAL_PRIMITIVE) {
+            T thit;
+            tvec3<T> candidateNormal;
+            if (IntersectCandidateProceduralPrimitive<T>(ctx, q, accuracy, thit, candidateNormal)) {
+                q.CommitProceduralPrimitiveHit(float(thit));
+                committedNormal = tvec3<T>(vec3(candidateNormal));  // float, as the HLSL's attribute
+            }
+        } else {
+            q.CommitNonOpaqueTriangleHit();  // no any-hit shader in the sample: TraceRay would accept it
+        }
+    }
+    hitPosition = tvec3<T>(T(0));
+    normal = tvec3<T>(T(0));
+    const uint32_t status = q.CommittedStatus();
+    if (status == COMMITTED_NOTHING) return false;
+    hitPosition = origin + T(q.CommittedRayT()) * direction;
+    if (status == COMMITTED_TRIANGLE_HIT) {
+        // MyClosestHitShader_Triangle's normal: the first vertex's, untransformed.
+        const uint32_t baseIndex = q.CommittedPrimitiveIndex() * 6;
+        const GpuDescriptorHandle vertexBuffers = ctx.globalDescriptorTable(kVertexBuffers);
+        const uvec3 indices = unpack3x16BitIndices(
+            baseIndex, ctx.loadFromTable<uvec2>(vertexBuffers, /*g_indices*/ 0, /*Load2 at*/ baseIndex & ~3u));
+        normal = tvec3<T>(
+            ctx.loadFromTable<Vertex>(vertexBuffers, /*g_vertices*/ 1, uint64_t(indices[0]) * sizeof(Vertex)).normal);
+    } else {
+        normal = committedNormal;
+    }
+    return true;
+}
+
+// True when the occlusion ray meets any surface within AO_RADIUS.
+template <typename T>
+bool TraceOcclusionInline(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                          const tvec3<T>& origin, const tvec3<T>& direction) {
+    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), AO_RADIUS};
+    RayQuery<kInlineShadowQueryFlags> q(ctx);
+    q.TraceRayInline(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_NONE,
+                     traceRay[RayType::Shadow].instanceInclusionMask, rayDesc);
+    while (q.Proceed()) {
+        if (q.CandidateType() == CANDIDATE_PROCEDURAL_PRIMITIVE) {
+            T thit;
+            tvec3<T> normal;
+            if (IntersectCandidateProceduralPrimitive<T>(ctx, q, accuracy, thit, normal))
+                q.CommitProceduralPrimitiveHit(float(thit));
+        }
+    }
+    return q.CommittedStatus() != COMMITTED_NOTHING;
+}
+
+// [numthreads(8, 8, 1)] InlineAmbientOcclusionCS: one thread per pixel; threads past the render target's edge return.
+template <typename T>
+void InlineAmbientOcclusionCS(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy) {
+    [[maybe_unused]] PrecisionScope<T> scope;
+    const uvec3 id = ctx.DispatchThreadID();
+    Image& target = ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView));
+    const uint32_t width = target.width(), height = target.height();  // g_renderTarget.GetDimensions
+    if (id.x >= width || id.y >= height) return;
+
+    const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
+    tvec3<T> origin, rayDir;
+    GenerateCameraRay(uvec2(id), uvec2(width, height), tvec3<T>(vec3(g_sceneCB.cameraPosition)),
+                      g_sceneCB.projectionToWorld, origin, rayDir);
+    tvec3<T> hitPosition, normal;
+    tvec4<T> color = tvec4<T>(BackgroundColor);
+    if (TracePrimaryInline<T>(ctx, traceRay, accuracy, origin, rayDir, hitPosition, normal)) {
+        const uint32_t seed = Hash(id.x ^ Hash(id.y));
+        uint32_t escaped = 0;
+        for (uint32_t i = 0; i < AO_RAY_COUNT; ++i) {
+            const T u1 = T(UnitFloat(Hash(seed ^ (2 * i))));
+            const T u2 = T(UnitFloat(Hash(seed ^ (2 * i + 1))));
+            const tvec3<T> direction = CosineHemisphereDirection(normal, u1, u2);
+            if (!TraceOcclusionInline<T>(ctx, traceRay, accuracy, hitPosition + T(AO_ORIGIN_OFFSET) * normal, direction))
+                escaped++;
+        }
+        const T ao = T(escaped) / T(AO_RAY_COUNT);
+        color = tvec4<T>(ao, ao, ao, T(1));
+    }
+    target.at(id.x, id.y) = vec4(color);
+}
+
 // Each intersection shader starts from zero-initialised attributes (H6) and reports HitKind 0 with the world normal.
 template <typename T>
-void MyIntersectionShader_AnalyticPrimitive(ShaderContext& ctx) {
+void IntersectionShaderOf(ShaderContext& ctx, IntersectionShader shader, const Accuracy& accuracy) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const PrimitiveInstancePerFrameBuffer aabbAttribute = primitiveAttributes(ctx);
     const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx, aabbAttribute);
-    const auto primitiveType = AnalyticPrimitive::Enum(aabbCB(ctx).primitiveType);
-    const math::RayExtent<T> extent = CurrentExtent<T>(ctx);
-
-    // RayAnalyticGeometryIntersectionTest: the local box is <-1,1>^3.
-    math::AnalyticHit<T> test;
-    switch (primitiveType) {
-        case AnalyticPrimitive::AABB: test = math::RayUnitCubeIntersectionTest(localRay, extent); break;
-        case AnalyticPrimitive::Spheres: test = math::RaySpheresIntersectionTest(localRay, extent); break;
-        default: break;
-    }
+    const PrimitiveInstanceConstantBuffer aabb = aabbCB(ctx);
+    const T elapsedTime = shader == IntersectionShader::VolumetricPrimitive ? T(sceneCB(ctx).elapsedTime) : T(0);
+    const T stepScale = shader == IntersectionShader::SignedDistancePrimitive ? T(materialCB(ctx).stepScale) : T(1);
+    const PrimitiveHit<T> test =
+        IntersectPrimitive<T>(shader, aabb.primitiveType, localRay, CurrentExtent<T>(ctx), elapsedTime, stepScale, accuracy);
     if (test.hit) {
-        const ProceduralPrimitiveAttributes attr{vec3(NormalToWorld(ctx, aabbAttribute, test.normal))};
-        ctx.ReportHit(float(test.thit), /*hitKind*/ 0, attr);
-    }
-}
-
-template <typename T>
-void MyIntersectionShader_VolumetricPrimitive(ShaderContext& ctx, const Accuracy& accuracy) {
-    [[maybe_unused]] PrecisionScope<T> scope;
-    const PrimitiveInstancePerFrameBuffer aabbAttribute = primitiveAttributes(ctx);
-    const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx, aabbAttribute);
-    const auto primitiveType = VolumetricPrimitive::Enum(aabbCB(ctx).primitiveType);
-    const T elapsedTime = T(sceneCB(ctx).elapsedTime);
-
-    // RayVolumetricGeometryIntersectionTest: metaballs animated over a 12 s cycle. The march step depends on
-    // RayTCurrent() at call time (H10).
-    // PORT: the sample count and the normal's step come from the library's Accuracy.
-    math::MetaballsHit<T> test;
-    if (primitiveType == VolumetricPrimitive::Metaballs)
-        test = math::RayMetaballsIntersectionTest(localRay, CurrentExtent<T>(ctx), elapsedTime, T(12),
-                                                  metaballsParams<T>(accuracy));
-    if (test.hit) {
-        const ProceduralPrimitiveAttributes attr{vec3(NormalToWorld(ctx, aabbAttribute, test.normal))};
-        ctx.ReportHit(float(test.thit), /*hitKind*/ 0, attr);
-    }
-}
-
-template <typename T>
-void MyIntersectionShader_SignedDistancePrimitive(ShaderContext& ctx, const Accuracy& accuracy) {
-    [[maybe_unused]] PrecisionScope<T> scope;
-    const PrimitiveInstancePerFrameBuffer aabbAttribute = primitiveAttributes(ctx);
-    const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx, aabbAttribute);
-    const auto primitiveType = SignedDistancePrimitive(aabbCB(ctx).primitiveType);
-
-    // RaySignedDistancePrimitiveTest: sphere tracing from RayTMin(), not from the box entry (I6).
-    // PORT: the threshold, step limit and normal offset come from the library's Accuracy.
-    const math::SphereTraceParams<T> params = sphereTraceParams(accuracy, T(materialCB(ctx).stepScale));
-    const auto sdf = [primitiveType](const tvec3<T>& position) {
-        return math::d3d12::GetDistanceFromSignedDistancePrimitive(position, primitiveType);
-    };
-    const math::SphereTraceResult<T> test =
-        math::RaySignedDistancePrimitiveTest(localRay, CurrentExtent<T>(ctx), sdf, params);
-    if (test.hit) {
-        const ProceduralPrimitiveAttributes attr{vec3(NormalToWorld(ctx, aabbAttribute, test.normal))};
+        const ProceduralPrimitiveAttributes attr{vec3(NormalToWorld(ctx.ObjectToWorld3x4(), aabbAttribute, test.normal))};
         ctx.ReportHit(float(test.thit), /*hitKind*/ 0, attr);
     }
 }
@@ -484,32 +699,49 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
     lib.addRayGeneration("MyRaygenShader", in([traceRay, accuracy](ShaderContext& ctx) {
                              MyRaygenShader<T>(ctx, traceRay, accuracy);
                          }));
-    lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
-        "MyClosestHitShader_Triangle",
-        in([traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
-                                         const BuiltInTriangleIntersectionAttributes& attr) {
-            MyClosestHitShader_Triangle<T>(ctx, traceRay, accuracy, effects, payload, attr);
-        }));
-    lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
-        "MyClosestHitShader_AABB",
-        in([traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
-                                         const ProceduralPrimitiveAttributes& attr) {
-            MyClosestHitShader_AABB<T>(ctx, traceRay, accuracy, effects, payload, attr);
-        }));
+    // The sample's closest hits, and the inline-shadow variants of scenes/inline/InlineShadows.hlsl.
+    for (const ShadowTracing tracing : {ShadowTracing::TraceRay, ShadowTracing::Inline}) {
+        const std::string suffix = tracing == ShadowTracing::Inline ? "_InlineShadow" : "";
+        lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
+            "MyClosestHitShader_Triangle" + suffix,
+            in([traceRay, accuracy, effects, tracing](ShaderContext& ctx, RayPayload& payload,
+                                                      const BuiltInTriangleIntersectionAttributes& attr) {
+                MyClosestHitShader_Triangle<T>(ctx, traceRay, accuracy, effects, payload, attr, tracing);
+            }));
+        lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
+            "MyClosestHitShader_AABB" + suffix,
+            in([traceRay, accuracy, effects, tracing](ShaderContext& ctx, RayPayload& payload,
+                                                      const ProceduralPrimitiveAttributes& attr) {
+                MyClosestHitShader_AABB<T>(ctx, traceRay, accuracy, effects, payload, attr, tracing);
+            }));
+    }
+    lib.declareRayQueries("MyClosestHitShader_Triangle_InlineShadow", {kInlineShadowQueryFlags});
+    lib.declareRayQueries("MyClosestHitShader_AABB_InlineShadow", {kInlineShadowQueryFlags});
+    lib.addCompute("InlineAmbientOcclusionCS", uvec3(8, 8, 1), in([traceRay, accuracy](ShaderContext& ctx) {
+                       InlineAmbientOcclusionCS<T>(ctx, traceRay, accuracy);
+                   }));
+    lib.declareRayQueries("InlineAmbientOcclusionCS", {kInlinePrimaryQueryFlags, kInlineShadowQueryFlags});
     lib.addMiss<RayPayload>("MyMissShader", MyMissShader);
     lib.addMiss<ShadowRayPayload>("MyMissShader_ShadowRay", MyMissShader_ShadowRay);
     // Each intersection shader's ReportHit is its last action, as in the HLSL: ReportHitEnd::Return spares the unwind
     // when a shadow ray's hit ends the search (docs/emulator.md, "Ending an intersection shader").
     lib.addIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_AnalyticPrimitive",
-        in([](ShaderContext& ctx) { MyIntersectionShader_AnalyticPrimitive<T>(ctx); }), ReportHitEnd::Return);
+        in([accuracy](ShaderContext& ctx) {
+            IntersectionShaderOf<T>(ctx, IntersectionShader::AnalyticPrimitive, accuracy);
+        }),
+        ReportHitEnd::Return);
     lib.addIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_VolumetricPrimitive",
-        in([accuracy](ShaderContext& ctx) { MyIntersectionShader_VolumetricPrimitive<T>(ctx, accuracy); }),
+        in([accuracy](ShaderContext& ctx) {
+            IntersectionShaderOf<T>(ctx, IntersectionShader::VolumetricPrimitive, accuracy);
+        }),
         ReportHitEnd::Return);
     lib.addIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_SignedDistancePrimitive",
-        in([accuracy](ShaderContext& ctx) { MyIntersectionShader_SignedDistancePrimitive<T>(ctx, accuracy); }),
+        in([accuracy](ShaderContext& ctx) {
+            IntersectionShaderOf<T>(ctx, IntersectionShader::SignedDistancePrimitive, accuracy);
+        }),
         ReportHitEnd::Return);
 }
 

@@ -28,6 +28,21 @@ void parseDataBuffers(ParseContext& ctx, const Value& value) {
         ObjectReader r(m.value, "buffer " + inQuotes(m.key));
         BufferDesc b;
         b.name = m.key;
+        if (const Value* structName = r.optional("struct")) {  // a StructuredBuffer of one of the file's structs
+            const int32_t index = int32_t(resolveName(*structName, ctx.structNames, "struct"));
+            const auto& elements = r.required("elements").asArray();
+            for (size_t i = 0; i < elements.size(); ++i) {
+                const std::vector<uint32_t> dwords = constantValue(
+                    ctx, elements[i], index, 0, "element " + std::to_string(i) + " of buffer " + inQuotes(m.key));
+                b.bytes.insert(b.bytes.end(), reinterpret_cast<const uint8_t*>(dwords.data()),
+                               reinterpret_cast<const uint8_t*>(dwords.data() + dwords.size()));
+            }
+            if (b.bytes.empty()) m.value.fail("buffer " + inQuotes(m.key) + " has no elements");
+            b.stride = uint32_t(ctx.scene.structs[size_t(index)].dwords * 4);
+            r.finish();
+            addBuffer(ctx, std::move(b), m.value);
+            continue;
+        }
         const uint32_t format = resolveName(r.required("format"), {"uint16", "uint32", "int32", "float32"}, "buffer format");
         for (const Value& v : r.required("data").asArray()) {
             uint32_t bits = 0;

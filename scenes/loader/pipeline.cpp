@@ -35,6 +35,10 @@ void setTraceRayArguments(const ParseContext& ctx, RayTypeDesc& t, uint32_t inde
 
 void parsePipeline(ParseContext& ctx, const Value& value) {
     ObjectReader r(value, "pipeline");
+    if (const Value* cs = r.optional("compute")) {  // a compute dispatch renders the scene (docs/ray-query.md)
+        ctx.scene.computeShader = cs->asString();
+        requireExport(ctx, *cs, dxr::ShaderStage::Compute);
+    }
     const Value& rg = r.required("rayGeneration");
     ctx.scene.rayGeneration = rg.asString();
     requireExport(ctx, rg, dxr::ShaderStage::RayGeneration);
