@@ -1,5 +1,6 @@
 #include "gpu/vulkan_dispatch.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -416,6 +417,24 @@ dxr::DispatchResult VulkanBackend::runCompute(dxr::Device& device, const Compute
         aov->height = dispatch.groups[1] * dispatch.numThreads[1] * dispatch.groups[2] * dispatch.numThreads[2];
         aov->inlineQuery = true;
         readAov(bound->aovBuffer, threads, *aov);
+        // Thread (x, y) is pixel (x, y): with one render target, the grid is cropped to it (the threads past its
+        // edge return without tracing).
+        if (bound->images.size() == 1) {
+            const Image& target = *bound->images.begin()->first;
+            const uint32_t planeHeight = dispatch.groups[1] * dispatch.numThreads[1];
+            if (target.width() <= aov->width && target.height() <= planeHeight) {
+                for (std::vector<uint32_t>* column : {&aov->record, &aov->instanceIndex, &aov->instanceID,
+                                                      &aov->geometryIndex, &aov->primitiveIndex}) {
+                    std::vector<uint32_t> cropped(size_t(target.width()) * target.height());
+                    for (uint32_t y = 0; y < target.height(); ++y)
+                        std::copy_n(column->begin() + size_t(y) * aov->width, target.width(),
+                                    cropped.begin() + size_t(y) * target.width());
+                    *column = std::move(cropped);
+                }
+                aov->width = target.width();
+                aov->height = target.height();
+            }
+        }
     }
     return result;
 }

@@ -32,8 +32,9 @@ struct VulkanBackendOptions {
 };
 
 // What an AOV dispatch reports per launch index (row-major), each kAovMiss where the primary ray missed.
-// A compute dispatch (inlineQuery) reports each thread's first ray query instead, over the whole thread grid
-// (width = groups x numThreads along X; threads past the render target's edge stay kAovMiss).
+// A compute dispatch (inlineQuery) reports each thread's first ray query instead: thread (x, y) is pixel (x, y),
+// cropped to the render target where the dispatch binds one (else the whole thread grid, width = groups x
+// numThreads along X).
 struct AovPixels {
     static constexpr uint32_t kAovMiss = 0xFFFFFFFFu;
     uint32_t width = 0, height = 0;
