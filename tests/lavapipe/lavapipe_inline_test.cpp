@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <sstream>
 #include <string>
 
 #include "core/image.h"
@@ -70,10 +71,12 @@ TEST(LavapipeInline, InlineShadowSceneEqualsTheTraceRaySceneBitForBit) {
         for (uint32_t x = 0; x < inlineImage.width(); ++x) {
             const vec4 a = inlineImage.at(x, y), b = traceRayImage.at(x, y);
             if (std::memcmp(&a, &b, sizeof a) == 0) continue;
-            if (differing++ == 0)
-                first = "(" + std::to_string(x) + "," + std::to_string(y) + ") inline " + std::to_string(a.x) + " " +
-                        std::to_string(a.y) + " " + std::to_string(a.z) + ", TraceRay " + std::to_string(b.x) + " " +
-                        std::to_string(b.y) + " " + std::to_string(b.z);
+            if (differing++ == 0) {  // (a stream: GCC 12 warns falsely, -Wrestrict, on a chain of string + at -O3)
+                std::ostringstream where;
+                where << "(" << x << "," << y << ") inline " << a.x << " " << a.y << " " << a.z << ", TraceRay " << b.x
+                      << " " << b.y << " " << b.z;
+                first = where.str();
+            }
         }
     std::printf("inline-shadow vs TraceRay-shadow scene on lavapipe: %llu of %u pixels differ\n",
                 (unsigned long long)differing, inlineImage.width() * inlineImage.height());
