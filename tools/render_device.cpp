@@ -25,7 +25,7 @@ std::string vulkanDeviceSelector(const std::string& option) {
 
 #ifdef REFRAY_HAVE_VULKAN
 // The device's AOV values as primary hits. A compute dispatch's come from ray queries, which use no shader table:
-// they carry no record (indexMapOf then shows R + M×G + C of the scene's first ray type, as for any unknown record).
+// they carry no record (RQ-31), and a compute scene has no record or hit-group map (inspect/index_map.h).
 std::vector<scenes::PrimaryHit> primaryHitsOf(const gpu::AovPixels& aov) {
     std::vector<scenes::PrimaryHit> hits(aov.record.size());
     for (size_t i = 0; i < hits.size(); ++i) {
