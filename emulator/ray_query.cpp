@@ -263,8 +263,8 @@ void RayQueryObject::TraceRayInline(GpuVirtualAddress as, uint32_t rayFlags, uin
     }
     q.dynamicFlags = rayFlags;
     q.rs.ray = ray;
-    q.rs.rayFlags = rayFlags | (q.templateFlags & kDefinedRayFlags);  // RQ-3, RQ-26
-    q.rs.effectiveFlags = q.rs.rayFlags;
+    q.rs.rayFlags = rayFlags | q.templateFlags;  // RQ-26
+    q.rs.effectiveFlags = rayFlags | (q.templateFlags & kDefinedRayFlags);  // RQ-3
     q.rs.instanceInclusionMask = mask & kInstanceInclusionMaskBits;  // RQ-10
     q.rs.tCurrent = ray.TMax;                                        // RQ-27
     ts.rayCounter++;
