@@ -76,6 +76,19 @@ bool hasExtension(const std::vector<VkExtensionProperties>& extensions, const st
                        [&](const VkExtensionProperties& e) { return name == e.extensionName; });
 }
 
+// VK_KHR_ray_query with the rayQuery feature: what a shader that traces inline needs (RayTracingLimits::rayQuery).
+bool deviceHasRayQueries(const VulkanFunctions& vk, VkPhysicalDevice device) {
+    VkPhysicalDeviceProperties properties;
+    vk.vkGetPhysicalDeviceProperties(device, &properties);
+    if (properties.apiVersion < VK_API_VERSION_1_2 ||
+        !hasExtension(deviceExtensions(vk, device), VK_KHR_RAY_QUERY_EXTENSION_NAME))
+        return false;
+    auto rayQuery = vkStruct<VkPhysicalDeviceRayQueryFeaturesKHR>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR);
+    auto base = vkStruct<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &rayQuery);
+    vk.vkGetPhysicalDeviceFeatures2(device, &base);
+    return rayQuery.rayQuery == VK_TRUE;
+}
+
 int64_t computeQueueFamily(const VulkanFunctions& vk, VkPhysicalDevice device) {
     uint32_t count = 0;
     vk.vkGetPhysicalDeviceQueueFamilyProperties(device, &count, nullptr);
@@ -221,7 +234,7 @@ std::vector<PhysicalDeviceSummary> VulkanContext::summaries() const {
         d.apiVersion = versionText(p.apiVersion);
         d.missing = missingRequirements(f, devices[i], true);
         d.rayTracing = d.missing.empty();
-        d.rayQuery = hasExtension(deviceExtensions(f, devices[i]), VK_KHR_RAY_QUERY_EXTENSION_NAME);
+        d.rayQuery = deviceHasRayQueries(f, devices[i]);
         out.push_back(std::move(d));
     }
     return out;

@@ -30,7 +30,7 @@ struct PhysicalDeviceSummary {
     std::string name, type, driverName, driverInfo, apiVersion;
     bool cpu = false;                   // VK_PHYSICAL_DEVICE_TYPE_CPU: a software driver such as lavapipe, not a GPU
     bool rayTracing = false;            // qualifies for refray's back end (requiredDeviceExtensions + features)
-    bool rayQuery = false;              // offers VK_KHR_ray_query
+    bool rayQuery = false;              // offers VK_KHR_ray_query with the rayQuery feature
     std::vector<std::string> missing;   // what it lacks for ray tracing (empty when rayTracing)
 };
 
