@@ -33,7 +33,7 @@ std::string_view toString(ProfileStage stage) {
 void DispatchStats::merge(const DispatchStats& o) {
     raysTraced += o.raysTraced;
     candidates += o.candidates;
-    queriesTraced += o.queriesTraced;
+    rayQueries += o.rayQueries;
     queryCandidates += o.queryCandidates;
     queryCommits += o.queryCommits;
     for (size_t i = 0; i < raysPerGatherMode.size(); ++i) raysPerGatherMode[i] += o.raysPerGatherMode[i];

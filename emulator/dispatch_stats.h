@@ -57,14 +57,14 @@ struct DispatchStats {
     std::vector<uint64_t> raysPerDepth;  // index = depth of the invoked shaders (1 = primary)
     std::array<uint64_t, kShaderStageCount> invocations{};  // by ShaderStage
     uint64_t candidates = 0;
+    uint64_t rayQueries = 0;  // TraceRayInline calls (emulator/ray_query.h); their candidates count in `candidates`
     // Rays per traversal mode: every candidate gathered, the nearest sure commit bounding the gather, and
     // the occlusion query (DispatchOptions::specialise).
     std::array<uint64_t, 3> raysPerGatherMode{};
 
-    // RayQuery (inline tracing): TraceRayInline calls, candidates Proceed() handed to the shader (it returned TRUE:
-    // non-opaque triangles and procedural primitives, each the shader decides on), and commits (by Proceed for
-    // opaque triangles, RQ-14, and by the shader). ACCEPT_FIRST_HIT_AND_END_SEARCH shows here (RQ-16).
-    uint64_t queriesTraced = 0;
+    // RayQuery (inline tracing), beside `rayQueries`: the candidates Proceed() handed to the shader (it returned
+    // TRUE: non-opaque triangles and procedural primitives, each the shader decides on), and the commits (by Proceed
+    // for opaque triangles, RQ-14, and by the shader). ACCEPT_FIRST_HIT_AND_END_SEARCH shows here (RQ-16).
     uint64_t queryCandidates = 0;
     uint64_t queryCommits = 0;
 

@@ -239,6 +239,7 @@ void RayQueryObject::TraceRayInline(GpuVirtualAddress as, uint32_t rayFlags, uin
     const detail::Site site = detail::siteOf(*q.inv);
     // RQ-9: whatever the state, the current query is discarded.
     q.id = ++ts.queriesTraced;
+    ts.stats.rayQueries++;
     q.phase = QueryPhase::Initialised;
     q.proceeded = false;
     q.searchEnded = false;
@@ -264,12 +265,11 @@ void RayQueryObject::TraceRayInline(GpuVirtualAddress as, uint32_t rayFlags, uin
     }
     q.dynamicFlags = rayFlags;
     q.rs.ray = ray;
-    q.rs.rayFlags = rayFlags | (q.templateFlags & kDefinedRayFlags);  // RQ-3, RQ-26
-    q.rs.effectiveFlags = q.rs.rayFlags;
+    q.rs.rayFlags = rayFlags | q.templateFlags;  // RQ-26
+    q.rs.effectiveFlags = rayFlags | (q.templateFlags & kDefinedRayFlags);  // RQ-3
     q.rs.instanceInclusionMask = mask & kInstanceInclusionMaskBits;  // RQ-10
     q.rs.tCurrent = ray.TMax;                                        // RQ-27
     ts.rayCounter++;
-    ts.stats.queriesTraced++;
 
     if (ts.dispatch->options.observer) {
         TraceEvent e = detail::queryEvent(q, TraceEvent::Kind::QueryInit);
@@ -307,7 +307,7 @@ bool RayQueryObject::Proceed() {
         q.phase = result ? QueryPhase::Candidate : QueryPhase::Finished;
         if (result) ts.stats.queryCandidates++;
     }
-    if (detail::observer(ts)) {
+    if (detail::observer(ts) && q.id != 0) {  // a query never initialised has no life to show
         TraceEvent e = detail::queryEvent(q, TraceEvent::Kind::QueryProceed);
         e.accepted = result;
         if (result) detail::setQueryHit(e, q.candidate);

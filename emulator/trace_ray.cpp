@@ -174,8 +174,8 @@ const TopLevelAS* lookupTopLevelAS(ThreadState& ts, GpuVirtualAddress asAddress)
 void raiseNotTopLevelAS(ThreadState& ts, const Site& site, GpuVirtualAddress asAddress) {
     const bool isBottom = ts.dispatch->device->findBottomLevelAS(asAddress) != nullptr;
     raise(ts, site, diag(isBottom ? "INST-10" : "RAY-1",
-                         isBottom ? "TraceRay was given a BLAS; it needs a TLAS"
-                                  : "TraceRay was given an address that is not an acceleration structure")
+                         isBottom ? "TraceRay/TraceRayInline was given a BLAS; it needs a TLAS"
+                                  : "TraceRay/TraceRayInline was given an address that is not an acceleration structure")
                         .hex("AccelerationStructure", asAddress));
 }
 

@@ -76,6 +76,19 @@ bool hasExtension(const std::vector<VkExtensionProperties>& extensions, const st
                        [&](const VkExtensionProperties& e) { return name == e.extensionName; });
 }
 
+// VK_KHR_ray_query with the rayQuery feature: what a shader that traces inline needs (RayTracingLimits::rayQuery).
+bool deviceHasRayQueries(const VulkanFunctions& vk, VkPhysicalDevice device) {
+    VkPhysicalDeviceProperties properties;
+    vk.vkGetPhysicalDeviceProperties(device, &properties);
+    if (properties.apiVersion < VK_API_VERSION_1_2 ||
+        !hasExtension(deviceExtensions(vk, device), VK_KHR_RAY_QUERY_EXTENSION_NAME))
+        return false;
+    auto rayQuery = vkStruct<VkPhysicalDeviceRayQueryFeaturesKHR>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR);
+    auto base = vkStruct<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &rayQuery);
+    vk.vkGetPhysicalDeviceFeatures2(device, &base);
+    return rayQuery.rayQuery == VK_TRUE;
+}
+
 int64_t computeQueueFamily(const VulkanFunctions& vk, VkPhysicalDevice device) {
     uint32_t count = 0;
     vk.vkGetPhysicalDeviceQueueFamilyProperties(device, &count, nullptr);
@@ -221,7 +234,7 @@ std::vector<PhysicalDeviceSummary> VulkanContext::summaries() const {
         d.apiVersion = versionText(p.apiVersion);
         d.missing = missingRequirements(f, devices[i], true);
         d.rayTracing = d.missing.empty();
-        d.rayQuery = hasExtension(deviceExtensions(f, devices[i]), VK_KHR_RAY_QUERY_EXTENSION_NAME);
+        d.rayQuery = deviceHasRayQueries(f, devices[i]);
         out.push_back(std::move(d));
     }
     return out;
@@ -340,6 +353,7 @@ void VulkanContext::createDevice() {
         accelerationStructure.minAccelerationStructureScratchOffsetAlignment;
     limits_.maxUniformBufferRange = p.limits.maxUniformBufferRange;
     limits_.maxBoundDescriptorSets = p.limits.maxBoundDescriptorSets;
+    for (int axis = 0; axis < 3; ++axis) limits_.maxComputeWorkGroupCount[axis] = p.limits.maxComputeWorkGroupCount[axis];
     f.vkGetPhysicalDeviceMemoryProperties(physicalDevice_, &memory_);
 
     uint32_t familyCount = 0;
@@ -349,10 +363,17 @@ void VulkanContext::createDevice() {
     if (families[queueFamily_].timestampValidBits > 0 && p.limits.timestampComputeAndGraphics)
         limits_.timestampPeriod = p.limits.timestampPeriod;
 
-    // Features: the required ones, plus primitive culling where the device has it.
+    // Features: the required ones, plus primitive culling where the device has it, plus ray queries where the
+    // device offers VK_KHR_ray_query (its feature struct is chained only then).
+    const bool rayQueryExtension =
+        options_.rayTracing && hasExtension(deviceExtensions(f, physicalDevice_), VK_KHR_RAY_QUERY_EXTENSION_NAME);
     FeatureChain available;
     if (!options_.rayTracing) available.vulkan12.pNext = nullptr;  // no ray-tracing feature structs
+    auto availableRayQuery =
+        vkStruct<VkPhysicalDeviceRayQueryFeaturesKHR>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR);
+    if (rayQueryExtension) available.rayTracingPipeline.pNext = &availableRayQuery;
     f.vkGetPhysicalDeviceFeatures2(physicalDevice_, &available.base);
+    limits_.rayQuery = rayQueryExtension && availableRayQuery.rayQuery == VK_TRUE;
     limits_.rayTraversalPrimitiveCulling = available.rayTracingPipeline.rayTraversalPrimitiveCulling == VK_TRUE;
     FeatureChain enabled;
     if (!options_.rayTracing) enabled.vulkan12.pNext = nullptr;
@@ -370,14 +391,19 @@ void VulkanContext::createDevice() {
     enabled.base.features.shaderSampledImageArrayDynamicIndexing = limits_.sampledImageArrays;
     enabled.vulkan12.runtimeDescriptorArray = limits_.sampledImageArrays;
     enabled.vulkan12.shaderSampledImageArrayNonUniformIndexing = limits_.sampledImageArrays;
+    auto enabledRayQuery =
+        vkStruct<VkPhysicalDeviceRayQueryFeaturesKHR>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR);
+    enabledRayQuery.rayQuery = VK_TRUE;
+    if (limits_.rayQuery) enabled.rayTracingPipeline.pNext = &enabledRayQuery;
 
     const float priority = 1.0f;
     auto queue = vkStruct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
     queue.queueFamilyIndex = queueFamily_;
     queue.queueCount = 1;
     queue.pQueuePriorities = &priority;
-    const std::vector<std::string> extensionNames =
+    std::vector<std::string> extensionNames =
         options_.rayTracing ? requiredDeviceExtensions() : std::vector<std::string>{};
+    if (limits_.rayQuery) extensionNames.push_back(VK_KHR_RAY_QUERY_EXTENSION_NAME);
     std::vector<const char*> extensions;
     for (const std::string& e : extensionNames) extensions.push_back(e.c_str());
     auto info = vkStruct<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);

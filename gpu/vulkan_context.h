@@ -30,7 +30,7 @@ struct PhysicalDeviceSummary {
     std::string name, type, driverName, driverInfo, apiVersion;
     bool cpu = false;                   // VK_PHYSICAL_DEVICE_TYPE_CPU: a software driver such as lavapipe, not a GPU
     bool rayTracing = false;            // qualifies for refray's back end (requiredDeviceExtensions + features)
-    bool rayQuery = false;              // offers VK_KHR_ray_query
+    bool rayQuery = false;              // offers VK_KHR_ray_query with the rayQuery feature
     std::vector<std::string> missing;   // what it lacks for ray tracing (empty when rayTracing)
 };
 
@@ -49,6 +49,11 @@ struct RayTracingLimits {
     // nonuniformEXT): runtimeDescriptorArray, shaderSampledImageArrayNonUniformIndexing and dynamic indexing.
     bool sampledImageArrays = false;
     uint32_t maxBoundDescriptorSets = 4;  // one set per register space in use (CONTRACT.md)
+    // Inline ray tracing (DXR 1.1 RayQuery, GLSL GL_EXT_ray_query): VK_KHR_ray_query with the rayQuery feature,
+    // enabled where the device has both. A shader module that declares the RayQueryKHR capability is refused
+    // without them (gpu/vulkan_pipeline.h, requireDeviceSupport).
+    bool rayQuery = false;
+    uint32_t maxComputeWorkGroupCount[3] = {65535, 65535, 65535};
 };
 
 // What a device needs for refray's back end, and why each item is there. The error for a machine without such a
@@ -58,6 +63,9 @@ struct RayTracingLimits {
 //   VK_KHR_acceleration_structure   BLAS/TLAS (and its dependency VK_KHR_deferred_host_operations)
 //   bufferDeviceAddress             SBT and AS inputs by address; root descriptors become device addresses
 //   scalarBlockLayout, shaderInt64  the shaders' layout(scalar) blocks and uint64_t root descriptors
+// Optional, enabled where the device has it: VK_KHR_ray_query with the rayQuery feature (RayTracingLimits::rayQuery),
+// which the shaders that trace inline need (the lent NVIDIA H100's driver offers ray-tracing pipelines without it;
+// Mesa's lavapipe has it).
 std::vector<std::string> requiredDeviceExtensions();
 
 struct VulkanContextOptions {

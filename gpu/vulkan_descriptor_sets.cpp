@@ -6,9 +6,12 @@
 namespace refray::gpu {
 
 namespace {
-constexpr VkShaderStageFlags kRayTracingStages =
+// Every binding is visible to the ray-tracing stages and to compute: DXR's global root signature is shared by
+// DispatchRays and Dispatch (a compute pipeline uses the same layout).
+constexpr VkShaderStageFlags kShaderStages =
     VK_SHADER_STAGE_RAYGEN_BIT_KHR | VK_SHADER_STAGE_ANY_HIT_BIT_KHR | VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR |
-    VK_SHADER_STAGE_MISS_BIT_KHR | VK_SHADER_STAGE_INTERSECTION_BIT_KHR | VK_SHADER_STAGE_CALLABLE_BIT_KHR;
+    VK_SHADER_STAGE_MISS_BIT_KHR | VK_SHADER_STAGE_INTERSECTION_BIT_KHR | VK_SHADER_STAGE_CALLABLE_BIT_KHR |
+    VK_SHADER_STAGE_COMPUTE_BIT;
 }
 
 DescriptorSets::DescriptorSets(const VulkanContext& context, const std::vector<DescriptorWrite>& writes)
@@ -31,7 +34,7 @@ DescriptorSets::DescriptorSets(const VulkanContext& context, const std::vector<D
                                       [&](const VkDescriptorSetLayoutBinding& b) { return b.binding == w.binding; }),
                          "two descriptors at binding " << w.binding << " of set " << set);
             REFRAY_CHECK(w.descriptorCount() > 0, "binding " << w.binding << " of set " << set << " holds no descriptors");
-            bindings.push_back({w.binding, w.type, w.descriptorCount(), kRayTracingStages,
+            bindings.push_back({w.binding, w.type, w.descriptorCount(), kShaderStages,
                                 w.immutableSampler ? &w.sampler : nullptr});
             typeCounts[w.type] += w.descriptorCount();
         }

@@ -31,7 +31,7 @@ struct DescriptorWrite {
 class DescriptorSets {
 public:
     // Sets 0 .. the highest set written (sets in between are empty); every binding is visible to every
-    // ray-tracing stage.
+    // ray-tracing stage and to compute.
     DescriptorSets(const VulkanContext& context, const std::vector<DescriptorWrite>& writes);
     ~DescriptorSets();
     DescriptorSets(const DescriptorSets&) = delete;

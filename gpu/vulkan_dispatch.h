@@ -4,6 +4,7 @@
 // scene builder (scenes/render_settings.h, RenderSettings::backend).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -31,14 +32,27 @@ struct VulkanBackendOptions {
 };
 
 // What an AOV dispatch reports per launch index (row-major), each kAovMiss where the primary ray missed.
+// A compute dispatch (inlineQuery) reports each thread's first ray query instead: thread (x, y) is pixel (x, y),
+// cropped to the render target where the dispatch binds one (else the whole thread grid, width = groups x
+// numThreads along X).
 struct AovPixels {
     static constexpr uint32_t kAovMiss = 0xFFFFFFFFu;
     uint32_t width = 0, height = 0;
-    std::vector<uint32_t> record;         // the hit-group record the committed hit used (its own index)
+    bool inlineQuery = false;             // a compute dispatch: no shader table, so no record
+    // DispatchRays: the hit-group record the committed hit used (its own index). Dispatch: the first query's
+    // committed status (COMMITTED_TRIANGLE_HIT 1, COMMITTED_PROCEDURAL_PRIMITIVE_HIT 2).
+    std::vector<uint32_t> record;
     std::vector<uint32_t> instanceIndex;  // gl_InstanceID (DXR InstanceIndex())
     std::vector<uint32_t> instanceID;     // gl_InstanceCustomIndexEXT (DXR InstanceID())
     std::vector<uint32_t> geometryIndex;  // gl_GeometryIndexEXT
     std::vector<uint32_t> primitiveIndex; // gl_PrimitiveID
+};
+
+// One compute dispatch (DXR Dispatch of a compute shader): the export, its [numthreads] and the thread-group counts.
+struct ComputeDispatch {
+    std::string exportName;
+    std::array<uint32_t, 3> numThreads{1, 1, 1};
+    std::array<uint32_t, 3> groups{1, 1, 1};  // ThreadGroupCountX, Y, Z
 };
 
 class VulkanBackend {
@@ -65,10 +79,35 @@ public:
     AovPixels dispatchAov(dxr::Device& device, const dxr::DispatchRaysDesc& desc, const dxr::StateObjectPtr& pipeline,
                           const dxr::GlobalRootArguments* globals);
 
+    // Dispatch of a compute shader: the same translation of the global root arguments (one descriptor set layout,
+    // the binding contract of gpu/shaders/CONTRACT.md), a compute pipeline from <library>/<Export>.comp.spv and
+    // vkCmdDispatch with the group counts; each render target is read back as dispatchRays does. DispatchResult::seconds
+    // is the GPU time of vkCmdDispatch. Throws refray::Error when the module is missing, its local size is not the
+    // export's [numthreads], or it traces inline on a device without ray queries (naming the device).
+    dxr::DispatchResult dispatchCompute(dxr::Device& device, const ComputeDispatch& dispatch,
+                                        const dxr::GlobalRootArguments* globals);
+    // The same arguments as dxr::Device::dispatch: the state object's compute export `desc.ComputeShader` (its
+    // [numthreads]) and the group counts, run by dispatchCompute. Options the GPU cannot honour throw, as for
+    // dispatchRays; an export the state object does not have throws refray::Error.
+    dxr::DispatchResult dispatch(dxr::Device& device, const dxr::DispatchDesc& desc, const dxr::StateObjectPtr& pipeline,
+                                 const dxr::GlobalRootArguments* globals, const dxr::DispatchOptions& options = {});
+    // dispatch's AOV: each thread's first ray query (dispatchComputeAov).
+    AovPixels dispatchAov(dxr::Device& device, const dxr::DispatchDesc& desc, const dxr::StateObjectPtr& pipeline,
+                          const dxr::GlobalRootArguments* globals);
+    // The compute AOV dispatch: <Export>.aov.comp.spv, which records each thread's first ray query's committed hit
+    // (gpu/shaders/common/d3d12_ray_query.glsl, REFRAY_AOV_FIRST_QUERY).
+    AovPixels dispatchComputeAov(dxr::Device& device, const ComputeDispatch& dispatch,
+                                 const dxr::GlobalRootArguments* globals);
+
 private:
-    struct Run;
+    ComputeDispatch computeDispatchOf(const dxr::DispatchDesc& desc, const dxr::StateObjectPtr& pipeline) const;
+    struct BoundGlobals;
+    std::unique_ptr<BoundGlobals> bindGlobals(dxr::Device& device, const dxr::GlobalRootArguments& globals,
+                                              uint64_t aovValues) const;
     dxr::DispatchResult run(dxr::Device& device, const dxr::DispatchRaysDesc& desc, const dxr::StateObjectPtr& pipeline,
                             const dxr::GlobalRootArguments* globals, AovPixels* aov);
+    dxr::DispatchResult runCompute(dxr::Device& device, const ComputeDispatch& dispatch,
+                                   const dxr::GlobalRootArguments* globals, AovPixels* aov);
 
     VulkanBackendOptions options_;
     std::unique_ptr<VulkanContext> context_;

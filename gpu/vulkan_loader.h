@@ -82,7 +82,9 @@ namespace refray::gpu {
     X(vkDestroyQueryPool)                            \
     X(vkCmdResetQueryPool)                           \
     X(vkCmdWriteTimestamp)                           \
-    X(vkGetQueryPoolResults)
+    X(vkGetQueryPoolResults)                         \
+    X(vkCreateComputePipelines)                      \
+    X(vkCmdDispatch)
 
 #define REFRAY_VULKAN_RAY_TRACING_FUNCTIONS(X)       \
     X(vkCreateAccelerationStructureKHR)              \

@@ -86,28 +86,107 @@ PipelineShape describePipeline(const dxr::StateObject& stateObject, const std::f
     return shape;
 }
 
-namespace {
-
-std::vector<uint32_t> readSpirv(const PipelineStage& stage) {
-    std::ifstream file(stage.spirv, std::ios::binary | std::ios::ate);
-    REFRAY_CHECK(file, "no SPIR-V for export '" << stage.exportName << "' (" << stageExtension(stage.stage)
-                                                << "): expected " << stage.spirv.string()
-                                                << " (compiled from its GLSL port gpu/shaders/<library>/"
-                                                << stage.exportName << "." << stageExtension(stage.stage)
-                                                << "; give --spirv-dir or REFRAY_SPIRV_DIR if the .spv files are "
-                                                   "elsewhere)");
-    const std::streamsize size = file.tellg();
-    REFRAY_CHECK(size > 0 && size % 4 == 0, stage.spirv.string() << " (export '" << stage.exportName
-                                                                 << "') is not a SPIR-V module: " << size << " bytes");
+std::vector<uint32_t> readSpirvModule(const std::filesystem::path& file, const std::string& exportName,
+                                      std::string_view stage) {
+    std::ifstream in(file, std::ios::binary | std::ios::ate);
+    REFRAY_CHECK(in, "no SPIR-V for export '" << exportName << "' (" << stage << "): expected " << file.string()
+                                              << " (compiled from its GLSL port gpu/shaders/<library>/" << exportName
+                                              << "." << stage
+                                              << "; give --spirv-dir or REFRAY_SPIRV_DIR if the .spv files are "
+                                                 "elsewhere)");
+    const std::streamsize size = in.tellg();
+    REFRAY_CHECK(size > 0 && size % 4 == 0,
+                 file.string() << " (export '" << exportName << "') is not a SPIR-V module: " << size << " bytes");
     std::vector<uint32_t> words(size_t(size) / 4);
-    file.seekg(0);
-    file.read(reinterpret_cast<char*>(words.data()), size);
-    REFRAY_CHECK(words[0] == 0x07230203u, stage.spirv.string() << " (export '" << stage.exportName
-                                                               << "') does not start with the SPIR-V magic number");
+    in.seekg(0);
+    in.read(reinterpret_cast<char*>(words.data()), size);
+    REFRAY_CHECK(words[0] == 0x07230203u,
+                 file.string() << " (export '" << exportName << "') does not start with the SPIR-V magic number");
     return words;
 }
 
-}  // namespace
+SpirvFacts inspectSpirv(const std::vector<uint32_t>& words, const std::string& what) {
+    // SPIR-V 1.6 section 2.3: a 5-word header, then instructions whose first word is (word count << 16) | opcode.
+    constexpr uint32_t kOpExecutionMode = 16, kOpCapability = 17, kOpFunction = 54;
+    constexpr uint32_t kCapabilityRayQueryKHR = 4472, kExecutionModeLocalSize = 17;
+    REFRAY_CHECK(words.size() >= 5 && words[0] == 0x07230203u, what << " is not a SPIR-V module");
+    SpirvFacts facts;
+    for (size_t i = 5; i < words.size();) {
+        const uint32_t count = words[i] >> 16, opcode = words[i] & 0xFFFFu;
+        REFRAY_CHECK(count > 0 && i + count <= words.size(),
+                     what << ": SPIR-V instruction at word " << i << " runs past the module's end");
+        if (opcode == kOpCapability && count >= 2 && words[i + 1] == kCapabilityRayQueryKHR) facts.rayQuery = true;
+        if (opcode == kOpExecutionMode && count >= 6 && words[i + 2] == kExecutionModeLocalSize)
+            facts.localSize = std::array<uint32_t, 3>{words[i + 3], words[i + 4], words[i + 5]};
+        if (opcode == kOpFunction) break;  // capabilities and execution modes precede every function
+        i += count;
+    }
+    return facts;
+}
+
+std::string deviceRefusal(const DeviceInfo& device, bool deviceHasRayQuery, const SpirvFacts& facts,
+                          const std::string& exportName, std::string_view stage, const std::filesystem::path& file) {
+    if (!facts.rayQuery || deviceHasRayQuery) return "";
+    return "export '" + exportName + "' (" + std::string(stage) + ", " + file.string() +
+           ") traces inline (its SPIR-V declares the RayQueryKHR capability, GL_EXT_ray_query), but the Vulkan device " +
+           std::to_string(device.index) + " '" + device.name + "' (" + device.driverName + " " + device.driverVersion +
+           ") does not offer VK_KHR_ray_query with the rayQuery feature. Scenes that trace inline need a device with "
+           "ray queries: 'refray devices' lists which have them (Mesa's lavapipe does: --vulkan-device llvmpipe)";
+}
+
+void requireDeviceSupport(const VulkanContext& context, const SpirvFacts& facts, const std::string& exportName,
+                          std::string_view stage, const std::filesystem::path& file) {
+    const std::string refusal = deviceRefusal(context.info(), context.limits().rayQuery, facts, exportName, stage, file);
+    if (!refusal.empty()) throw Error(refusal);
+}
+
+std::filesystem::path computeSpirvPath(const std::filesystem::path& spirvDirectory, const std::string& library,
+                                       const std::string& exportName, bool aov) {
+    return spirvDirectory / library / (exportName + (aov ? ".aov.comp.spv" : ".comp.spv"));
+}
+
+ComputeShaderModule::ComputeShaderModule(const VulkanContext& context, const std::filesystem::path& file_,
+                                         const std::string& exportName_, const std::array<uint32_t, 3>& numThreads)
+    : file(file_), exportName(exportName_), words(readSpirvModule(file, exportName, "comp")),
+      facts(inspectSpirv(words, file.string())) {
+    REFRAY_CHECK(facts.localSize, file.string() << " (export '" << exportName
+                                                << "') declares no LocalSize: is it a compute shader?");
+    const std::array<uint32_t, 3>& local = *facts.localSize;
+    REFRAY_CHECK(local == numThreads, file.string() << " (export '" << exportName << "') has local_size " << local[0]
+                                                    << "x" << local[1] << "x" << local[2]
+                                                    << ", but the export's [numthreads] is " << numThreads[0] << "x"
+                                                    << numThreads[1] << "x" << numThreads[2]);
+    requireDeviceSupport(context, facts, exportName, "comp", file);
+}
+
+ComputePipeline::ComputePipeline(const VulkanContext& context, const ComputeShaderModule& module,
+                                 VkPipelineLayout layout, const std::vector<TraceRayConstants>& traceRay)
+    : context_(context) {
+    const VulkanFunctions& f = context.vk();
+    auto moduleInfo = vkStruct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
+    moduleInfo.codeSize = module.words.size() * 4;
+    moduleInfo.pCode = module.words.data();
+    VkShaderModule shader = VK_NULL_HANDLE;
+    REFRAY_VK(f.vkCreateShaderModule(context.device(), &moduleInfo, nullptr, &shader));
+    const SpecializationData constants = specializationData(traceRay);
+    const VkSpecializationInfo specialization = constants.info();
+    auto info = vkStruct<VkComputePipelineCreateInfo>(VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO);
+    info.stage = vkStruct<VkPipelineShaderStageCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO);
+    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    info.stage.module = shader;
+    info.stage.pName = "main";
+    info.stage.pSpecializationInfo = &specialization;
+    info.layout = layout;
+    const VkResult result = f.vkCreateComputePipelines(context.device(), VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_);
+    f.vkDestroyShaderModule(context.device(), shader, nullptr);
+    REFRAY_CHECK(result == VK_SUCCESS, "Vulkan: vkCreateComputePipelines for export '"
+                                           << module.exportName << "' (" << module.file.string() << ") returned "
+                                           << resultName(result));
+}
+
+ComputePipeline::~ComputePipeline() {
+    if (pipeline_) context_.vk().vkDestroyPipeline(context_.device(), pipeline_, nullptr);
+}
 
 std::optional<uint32_t> SpecializationData::valueOf(uint32_t constantId) const {
     for (size_t i = 0; i < entries.size(); ++i)
@@ -157,7 +236,9 @@ RayTracingPipeline::RayTracingPipeline(const VulkanContext& context, const Pipel
     };
     try {
         for (const PipelineStage& stage : shape.stages) {
-            const std::vector<uint32_t> words = readSpirv(stage);
+            const std::vector<uint32_t> words = readSpirvModule(stage.spirv, stage.exportName, stageExtension(stage.stage));
+            requireDeviceSupport(context, inspectSpirv(words, stage.spirv.string()), stage.exportName,
+                                 stageExtension(stage.stage), stage.spirv);
             auto info = vkStruct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
             info.codeSize = words.size() * 4;
             info.pCode = words.data();

@@ -5,6 +5,7 @@
 // the state object's MaxTraceRecursionDepth.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -99,11 +100,67 @@ struct PipelineShape {
 PipelineShape describePipeline(const dxr::StateObject& stateObject, const std::filesystem::path& spirvDirectory,
                                const std::string& library, const AovShaders* aov = nullptr);
 
+// What refray needs to know about a SPIR-V module before handing it to a device.
+struct SpirvFacts {
+    bool rayQuery = false;  // declares the RayQueryKHR capability (GLSL GL_EXT_ray_query): it traces inline
+    std::optional<std::array<uint32_t, 3>> localSize;  // a compute module's LocalSize execution mode
+};
+// Pure: reads the capabilities and execution modes of a module's words. Throws refray::Error for words that are not
+// a SPIR-V module (`what` names it).
+SpirvFacts inspectSpirv(const std::vector<uint32_t>& words, const std::string& what);
+
+// The words of `file`, the module of export `exportName`'s `stage` ("rchit", "comp"). Throws refray::Error naming
+// the export and the file when it is missing or not a SPIR-V module.
+std::vector<uint32_t> readSpirvModule(const std::filesystem::path& file, const std::string& exportName,
+                                      std::string_view stage);
+
+// Pure: why `device` cannot run the module of `facts` (empty when it can): a module that traces inline needs ray
+// queries (VK_KHR_ray_query with the rayQuery feature, `deviceHasRayQuery`). The message names the export, the
+// file, the device and what it lacks.
+std::string deviceRefusal(const DeviceInfo& device, bool deviceHasRayQuery, const SpirvFacts& facts,
+                          const std::string& exportName, std::string_view stage, const std::filesystem::path& file);
+// Throws refray::Error with deviceRefusal's message where it is not empty.
+void requireDeviceSupport(const VulkanContext& context, const SpirvFacts& facts, const std::string& exportName,
+                          std::string_view stage, const std::filesystem::path& file);
+
+// <spirvDirectory>/<library>/<exportName>.comp.spv, or <exportName>.aov.comp.spv for refray's AOV (the same GLSL
+// compiled with REFRAY_AOV_FIRST_QUERY, gpu/CMakeLists.txt).
+std::filesystem::path computeSpirvPath(const std::filesystem::path& spirvDirectory, const std::string& library,
+                                       const std::string& exportName, bool aov);
+
+// A compute export's module, read and checked: its local size must be the export's [numthreads] (the GLSL port's
+// `layout(local_size_x = ...)`), and a module that traces inline needs a device with ray queries.
+struct ComputeShaderModule {
+    ComputeShaderModule(const VulkanContext& context, const std::filesystem::path& file, const std::string& exportName,
+                        const std::array<uint32_t, 3>& numThreads);
+    std::filesystem::path file;
+    std::string exportName;
+    std::vector<uint32_t> words;
+    SpirvFacts facts;
+};
+
+// A compute pipeline of one module with `layout`; the TraceRay specialization constants are given as to every
+// ray-tracing stage (a compute module declares none it does not read).
+class ComputePipeline {
+public:
+    ComputePipeline(const VulkanContext& context, const ComputeShaderModule& module, VkPipelineLayout layout,
+                    const std::vector<TraceRayConstants>& traceRay);
+    ~ComputePipeline();
+    ComputePipeline(const ComputePipeline&) = delete;
+    ComputePipeline& operator=(const ComputePipeline&) = delete;
+    VkPipeline handle() const { return pipeline_; }
+
+private:
+    const VulkanContext& context_;
+    VkPipeline pipeline_ = VK_NULL_HANDLE;
+};
+
 // The pipeline on the device, and the group handles in entry order.
 class RayTracingPipeline {
 public:
-    // Throws refray::Error naming the export and the file when a stage's SPIR-V is missing or unreadable, and when
-    // the recursion depth exceeds the device's maxRayRecursionDepth.
+    // Throws refray::Error naming the export and the file when a stage's SPIR-V is missing or unreadable, or traces
+    // inline on a device without ray queries (requireDeviceSupport), and when the recursion depth exceeds the
+    // device's maxRayRecursionDepth.
     // `traceRay`: the TraceRay arguments of each ray type, given to every stage as specialization constants
     // (specializationData); `recordIndexOffset`: the AOV closest hit's.
     RayTracingPipeline(const VulkanContext& context, const PipelineShape& shape, VkPipelineLayout layout,

@@ -89,8 +89,11 @@ Activity activity(const SceneDesc& scene, const ShaderLibraryFacts& facts, Shade
     for (const ShaderEffectUse& use : facts.uses) {
         if (use.effect != which) continue;
         a.libraryHasIt = true;
-        bool active = use.exportName == scene.rayGeneration;
+        // A compute scene runs its compute shader only: none of its records (docs/ray-query.md).
+        const bool compute = !scene.computeShader.empty();
+        bool active = use.exportName == (compute ? scene.computeShader : scene.rayGeneration);
         for (const RecordDesc& r : scene.hitGroupRecords) {
+            if (compute) break;
             const HitGroupDesc* g = r.hitGroup.empty() ? nullptr : findHitGroup(scene, r.hitGroup);
             if (!g || !hitGroupRuns(*g, use.exportName)) continue;
             if (use.gateField.empty()) {

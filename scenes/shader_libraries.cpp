@@ -79,6 +79,14 @@ ShaderLibraryFacts d3d12Facts() {
         {E::DistanceFog, "MyClosestHitShader_Triangle", "", "", 0.0f},
         {E::DistanceFog, "MyClosestHitShader_AABB", "", "", 0.0f},
         {E::RayDifferentials, "MyClosestHitShader_Triangle", "the grid lines", "", 0.0f},
+        // The inline-shadow closest hits (scenes/inline/InlineShadows.hlsl): the same effects, shadows traced inline.
+        {E::ShadowRays, "MyClosestHitShader_Triangle_InlineShadow", "a RayQuery", "", 0.0f},
+        {E::ShadowRays, "MyClosestHitShader_AABB_InlineShadow", "a RayQuery", "", 0.0f},
+        {E::Reflections, "MyClosestHitShader_Triangle_InlineShadow", "", "reflectanceCoef", 0.001f},
+        {E::Reflections, "MyClosestHitShader_AABB_InlineShadow", "", "reflectanceCoef", 0.001f},
+        {E::DistanceFog, "MyClosestHitShader_Triangle_InlineShadow", "", "", 0.0f},
+        {E::DistanceFog, "MyClosestHitShader_AABB_InlineShadow", "", "", 0.0f},
+        {E::RayDifferentials, "MyClosestHitShader_Triangle_InlineShadow", "the grid lines", "", 0.0f},
     };
     return f;
 }

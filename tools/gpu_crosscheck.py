@@ -22,13 +22,24 @@ STATS_FIRST_SEED = 100
 SPEED_SIZE = "1280x720"
 
 
+def aovs_of(root, scene):
+    """The index maps of a scene: a compute scene ("pipeline": {"compute": ...}) traces its primary rays with RayQuery,
+    which reads no shader record, so it has no record or hit-group map (docs/vulkan-backend.md, "AOVs")."""
+    if scene == "builtin":
+        return AOVS
+    desc = json.load(open(os.path.join(root, scene)))
+    if desc.get("pipeline", {}).get("compute"):
+        return [a for a in AOVS if a not in ("record", "hitgroup")]
+    return AOVS
+
+
 def plan(root, size):
     goldens = json.load(open(os.path.join(root, "tests/golden/goldens.json")))["goldens"]
     rows = []
     for g in goldens:
         setting = [g["scene"], g["camera"], g["time"], "%dx%d" % (g["width"], g["height"]), g["precision"]]
         rows.append(["image", g["name"]] + setting + ["-", "images/%s.exr" % g["name"], "-"])
-        for aov in AOVS:
+        for aov in aovs_of(root, g["scene"]):
             rows.append(["map", g["name"]] + setting[:3] + [size, "float", aov, "maps/%s.%s.exr" % (g["name"], aov), "-"])
         rows.append(["speed", g["name"]] + setting[:3] + [SPEED_SIZE, g["precision"], "-", "-", "-"])
     # Path-traced scenes: a statistics image (--batches) at the statistical golden's settings, other seeds.
@@ -45,7 +56,7 @@ def plan(root, size):
             continue
         name = lesson["name"]
         scene = os.path.relpath(path, root)
-        for aov in AOVS:
+        for aov in aovs_of(root, scene):
             rows.append(["map", name, scene, render.get("camera", "-"), "-", size, "float", aov,
                          "maps/%s.%s.exr" % (name, aov), "-"])
     for r in rows:

@@ -77,13 +77,13 @@ void printStats(const scenes::RenderResult& r, const Size& size) {
     for (const dxr::ExportInvocations& e : st.invocationsPerExport)
         std::printf("    %-13s %s: %llu\n", std::string(dxr::toString(e.stage)).c_str(), e.exportName.c_str(), u(e.count));
     std::printf("  candidates gathered: %llu\n", u(st.candidates));
+    if (st.rayQueries)
+        std::printf("  ray queries (TraceRayInline): %llu; candidates handed to the shader (Proceed() TRUE): %llu; "
+                    "commits: %llu\n",
+                    u(st.rayQueries), u(st.queryCandidates), u(st.queryCommits));
     std::printf("  rays per traversal mode: %llu every candidate, %llu bounded by the nearest sure commit, %llu "
                 "occlusion query\n",
                 u(st.raysPerGatherMode[0]), u(st.raysPerGatherMode[1]), u(st.raysPerGatherMode[2]));
-    if (st.queriesTraced)
-        std::printf("  RayQuery: %llu queries (TraceRayInline), %llu candidates handed to the shader (Proceed() TRUE), "
-                    "%llu commits\n",
-                    u(st.queriesTraced), u(st.queryCandidates), u(st.queryCommits));
 
     // Exclusive time per stage.
     const double total = st.profiledSeconds();
@@ -94,7 +94,9 @@ void printStats(const scenes::RenderResult& r, const Size& size) {
     std::printf("  time per stage (exclusive, summed over worker threads): %.3f s\n", total);
     for (size_t i = 0; i < dxr::kProfileStageCount; ++i) {
         const auto stage = dxr::ProfileStage(i);
-        const bool ran = stage == dxr::ProfileStage::Traversal ? st.raysTraced > 0 : st.invocations[i] > 0;
+        const bool ran = stage == dxr::ProfileStage::Traversal ? st.raysTraced > 0
+                         : stage == dxr::ProfileStage::Compute ? st.invocationsOf(dxr::ShaderStage::Compute) > 0
+                                                               : st.invocations[i] > 0;
         if (!ran) continue;
         std::printf("    %-13s %10.3f s %6.1f%%\n", std::string(dxr::toString(stage)).c_str(), st.secondsIn(stage),
                     total > 0 ? 100.0 * st.secondsIn(stage) / total : 0.0);
@@ -117,13 +119,8 @@ std::string statsJson(const scenes::RenderResult& r, const std::string& scene, c
     w.member("format", "refray-stats/1").member("scene", scene).member("width", size.width).member("height", size.height);
     w.member("wallSeconds", r.dispatch.seconds).member("raysTraced", st.raysTraced);
     w.member("raysPerSecond", r.dispatch.seconds > 0 ? double(st.raysTraced) / r.dispatch.seconds : 0.0);
-    w.member("candidates", st.candidates);
-    w.key("rayQueries")
-        .beginObject(json::Writer::Layout::Inline)
-        .member("queries", st.queriesTraced)
-        .member("candidatesHandedToTheShader", st.queryCandidates)
-        .member("commits", st.queryCommits)
-        .endObject();
+    w.member("candidates", st.candidates).member("rayQueries", st.rayQueries);
+    w.member("rayQueryCandidates", st.queryCandidates).member("rayQueryCommits", st.queryCommits);
     w.key("raysPerTraversalMode")
         .beginObject(json::Writer::Layout::Inline)
         .member("all", st.raysPerGatherMode[0])
@@ -390,6 +387,9 @@ int runRender(const RenderOptions& o) {
         }
     }
     for (const auto& w : result.dispatch.diagnostics.warnings()) std::fprintf(stderr, "%s\n", w.format().c_str());
+    // Notes: uses DXR defines that SPIR-V does not (RayQuery, docs/ray-query.md); they never fail a render.
+    for (const auto& n : result.dispatch.diagnostics.notes())
+        std::fprintf(stderr, "%s (%llu times)\n", n.format().c_str(), (unsigned long long)n.count);
     if (statistics) {
         statistics->mean.metadata["refray_version"] = tools::kVersion;
         statistics->mean.metadata["refray_commit"] = tools::kCommit;

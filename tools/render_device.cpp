@@ -23,6 +23,26 @@ std::string vulkanDeviceSelector(const std::string& option) {
     return env ? env : "";
 }
 
+#ifdef REFRAY_HAVE_VULKAN
+// The device's AOV values as primary hits. A compute dispatch's come from ray queries, which use no shader table:
+// they carry no record (RQ-31), and a compute scene has no record or hit-group map (inspect/index_map.h).
+std::vector<scenes::PrimaryHit> primaryHitsOf(const gpu::AovPixels& aov) {
+    std::vector<scenes::PrimaryHit> hits(aov.record.size());
+    for (size_t i = 0; i < hits.size(); ++i) {
+        scenes::PrimaryHit& h = hits[i];
+        h.traced = true;
+        h.hit = aov.record[i] != gpu::AovPixels::kAovMiss;
+        if (!h.hit) continue;
+        if (!aov.inlineQuery) h.record = aov.record[i];
+        h.instanceIndex = aov.instanceIndex[i];
+        h.geometryIndex = aov.geometryIndex[i];
+        h.primitiveIndex = aov.primitiveIndex[i];
+        h.instanceID = aov.instanceID[i];
+    }
+    return hits;
+}
+#endif
+
 }  // namespace
 
 RenderDevice makeRenderDevice(const std::string& device, const std::string& library, const scenes::SceneDesc* scene,
@@ -48,23 +68,18 @@ RenderDevice makeRenderDevice(const std::string& device, const std::string& libr
                         const dxr::GlobalRootArguments* globals, const dxr::DispatchOptions& dispatchOptions) {
         return raw->dispatchRays(d, desc, pipeline, globals, dispatchOptions);
     };
+    out.computeBackend = [raw](dxr::Device& d, const dxr::DispatchDesc& desc, const dxr::StateObjectPtr& pipeline,
+                               const dxr::GlobalRootArguments* globals, const dxr::DispatchOptions& dispatchOptions) {
+        return raw->dispatch(d, desc, pipeline, globals, dispatchOptions);
+    };
     const gpu::DeviceInfo& info = backend->deviceInfo();
     out.aov = [raw](dxr::Device& d, const dxr::DispatchRaysDesc& desc, const dxr::StateObjectPtr& pipeline,
                     const dxr::GlobalRootArguments* globals) {
-        const gpu::AovPixels aov = raw->dispatchAov(d, desc, pipeline, globals);
-        std::vector<scenes::PrimaryHit> hits(aov.record.size());
-        for (size_t i = 0; i < hits.size(); ++i) {
-            scenes::PrimaryHit& h = hits[i];
-            h.traced = true;
-            h.hit = aov.record[i] != gpu::AovPixels::kAovMiss;
-            if (!h.hit) continue;
-            h.record = aov.record[i];
-            h.instanceIndex = aov.instanceIndex[i];
-            h.geometryIndex = aov.geometryIndex[i];
-            h.primitiveIndex = aov.primitiveIndex[i];
-            h.instanceID = aov.instanceID[i];
-        }
-        return hits;
+        return primaryHitsOf(raw->dispatchAov(d, desc, pipeline, globals));
+    };
+    out.computeAov = [raw](dxr::Device& d, const dxr::DispatchDesc& desc, const dxr::StateObjectPtr& pipeline,
+                           const dxr::GlobalRootArguments* globals) {
+        return primaryHitsOf(raw->dispatchAov(d, desc, pipeline, globals));
     };
     out.provenance["device"] = "vulkan";
     out.provenance["gpu"] = info.name;
@@ -96,6 +111,13 @@ scenes::IndexMap renderDeviceIndexMap(const RenderDevice& device, scenes::Scene&
     s.backend = [&](dxr::Device& d, const dxr::DispatchRaysDesc& desc_, const dxr::StateObjectPtr& pipeline,
                     const dxr::GlobalRootArguments* globals, const dxr::DispatchOptions&) {
         hits = device.aov(d, desc_, pipeline, globals);
+        return dxr::DispatchResult{};
+    };
+    // A compute scene: each thread's first ray query (its primary ray).
+    s.computeBackend = [&](dxr::Device& d, const dxr::DispatchDesc& desc_, const dxr::StateObjectPtr& pipeline,
+                           const dxr::GlobalRootArguments* globals, const dxr::DispatchOptions&) {
+        REFRAY_CHECK(device.computeAov, "--aov: this device has no compute AOV dispatch");
+        hits = device.computeAov(d, desc_, pipeline, globals);
         return dxr::DispatchResult{};
     };
     scenes::RenderResult rendered = scene.render(s);
@@ -137,6 +159,7 @@ RenderDevice useRenderDevice(const std::string& device, const std::string& libra
     if (device == "vulkan") checkVulkanSettings(settings);
     RenderDevice out = makeRenderDevice(device, library, scene, spirvDirectory, vulkanDevice);
     settings.backend = out.backend;
+    settings.computeBackend = out.computeBackend;
     return out;
 }
 

@@ -16,6 +16,7 @@ namespace refray::tools {
 
 struct RenderDevice {
     scenes::DispatchBackend backend;                // empty: the emulator
+    scenes::ComputeBackend computeBackend;          // Dispatch of a compute scene; empty: the emulator
     std::map<std::string, std::string> provenance;  // image metadata: device, gpu, gpu_driver, vulkan_api
     std::shared_ptr<void> state;                    // keeps the back end alive while `backend` is in use
     // `--aov` on the device (empty: the emulator's trace): the AOV dispatch for `backend`'s arguments, each launch
@@ -23,6 +24,11 @@ struct RenderDevice {
     std::function<std::vector<scenes::PrimaryHit>(dxr::Device&, const dxr::DispatchRaysDesc&, const dxr::StateObjectPtr&,
                                                   const dxr::GlobalRootArguments*)>
         aov;
+    // The same for a compute scene (Dispatch): each thread's first ray query's committed hit (docs/vulkan-backend.md,
+    // "AOVs"). A query has no shader table, so the hits carry no record.
+    std::function<std::vector<scenes::PrimaryHit>(dxr::Device&, const dxr::DispatchDesc&, const dxr::StateObjectPtr&,
+                                                  const dxr::GlobalRootArguments*)>
+        computeAov;
 };
 
 // `device` is "cpu" or "vulkan"; `library` the scene's shader library (the SPIR-V folder); `scene` the scene file's
@@ -36,7 +42,7 @@ struct RenderDevice {
 RenderDevice makeRenderDevice(const std::string& device, const std::string& library, const scenes::SceneDesc* scene,
                               const std::string& spirvDirectory, const std::string& vulkanDevice = "");
 
-// makeRenderDevice, and for `vulkan` checkVulkanSettings(settings); sets settings.backend.
+// makeRenderDevice, and for `vulkan` checkVulkanSettings(settings); sets settings.backend and settings.computeBackend.
 RenderDevice useRenderDevice(const std::string& device, const std::string& library, const scenes::SceneDesc* scene,
                              const std::string& spirvDirectory, const std::string& vulkanDevice,
                              scenes::RenderSettings& settings);

@@ -1,4 +1,4 @@
-// Every rule id of dxr-semantics.md sections 0-13 is cited by a conformance test name or
+// Every rule id of dxr-semantics.md sections 0-13 and 18 is cited by a conformance test name or
 // by a line in unobservable_rules_*.md saying why it cannot be observed here.
 #include <gtest/gtest.h>
 

@@ -110,8 +110,8 @@ TEST(RayQueryLessons, RQ_16_AcceptFirstHitHandsTheShaderFewerCandidates) {
     {
         const dxr::DispatchStats with = base->render(settings).dispatch.stats;
         const dxr::DispatchStats without = lesson->render(settings).dispatch.stats;
-        EXPECT_GT(with.queriesTraced, 0u);
-        EXPECT_EQ(with.queriesTraced, without.queriesTraced);
+        EXPECT_GT(with.rayQueries, 0u);
+        EXPECT_EQ(with.rayQueries, without.rayQueries);
         EXPECT_LE(with.queryCandidates, without.queryCandidates);
         EXPECT_LE(with.queryCommits, without.queryCommits);
     }
@@ -120,12 +120,12 @@ TEST(RayQueryLessons, RQ_16_AcceptFirstHitHandsTheShaderFewerCandidates) {
     const RenderResult with = base->render(settings);
     const RenderResult without = lesson->render(settings);
     EXPECT_EQ(with.image.pixels(), without.image.pixels());
-    EXPECT_EQ(with.dispatch.stats.queriesTraced, without.dispatch.stats.queriesTraced);
+    EXPECT_EQ(with.dispatch.stats.rayQueries, without.dispatch.stats.rayQueries);
     EXPECT_LT(with.dispatch.stats.queryCandidates, without.dispatch.stats.queryCandidates);
     EXPECT_LT(with.dispatch.stats.queryCommits, without.dispatch.stats.queryCommits);
     // The TraceRay part of the scene is untouched.
-    EXPECT_EQ(with.dispatch.stats.raysTraced - with.dispatch.stats.queriesTraced,
-              without.dispatch.stats.raysTraced - without.dispatch.stats.queriesTraced);
+    EXPECT_EQ(with.dispatch.stats.raysTraced - with.dispatch.stats.rayQueries,
+              without.dispatch.stats.raysTraced - without.dispatch.stats.rayQueries);
 }
 
 // RQ-22: a procedural candidate the shader does not intersect is never committed: the shadow queries of the
@@ -136,7 +136,7 @@ TEST(RayQueryLessons, RQ_22_IgnoredProceduralCandidatesCommitNothing) {
     const RenderSettings settings = lessonSettings(lesson->desc().lesson);
     const dxr::DispatchStats with = base->render(settings).dispatch.stats;
     const dxr::DispatchStats without = lesson->render(settings).dispatch.stats;
-    EXPECT_EQ(with.queriesTraced, without.queriesTraced);
+    EXPECT_EQ(with.rayQueries, without.rayQueries);
     EXPECT_LT(without.queryCommits, with.queryCommits);
 }
 

@@ -24,7 +24,7 @@ using namespace shaders_rig;
 
 TEST(D3D12Shaders, EveryHlslExportExistsWithItsStage) {
     const auto lib = makeD3D12ShaderLibrary();
-    const std::map<std::string, ShaderStage> expected = {
+    std::map<std::string, ShaderStage> expected = {
         {"MyRaygenShader", ShaderStage::RayGeneration},
         {"MyClosestHitShader_Triangle", ShaderStage::ClosestHit},
         {"MyClosestHitShader_AABB", ShaderStage::ClosestHit},
@@ -33,13 +33,46 @@ TEST(D3D12Shaders, EveryHlslExportExistsWithItsStage) {
         {"MyIntersectionShader_AnalyticPrimitive", ShaderStage::Intersection},
         {"MyIntersectionShader_VolumetricPrimitive", ShaderStage::Intersection},
         {"MyIntersectionShader_SignedDistancePrimitive", ShaderStage::Intersection},
+        // scenes/inline/InlineShadows.hlsl and InlineAmbientOcclusion.hlsl (RQ-1, RQ-2).
+        {"MyClosestHitShader_Triangle_InlineShadow", ShaderStage::ClosestHit},
+        {"MyClosestHitShader_AABB_InlineShadow", ShaderStage::ClosestHit},
+        {"InlineAmbientOcclusionCS", ShaderStage::Compute},
     };
+    // The variants of the inline-tracing exports for the RayQuery lessons and mutants (InlineVariant): each of the
+    // three with a suffix. SearchAllHits's shadow query lacks ACCEPT_FIRST_HIT_AND_END_SEARCH.
+    for (const char* variant :
+         {"_IgnoreProcedural", "_SearchAllHits", "_ReadCommittedAfterMiss", "_NoRangeCheck", "_CommittedTIsTMax"}) {
+        expected[std::string("MyClosestHitShader_Triangle_InlineShadow") + variant] = ShaderStage::ClosestHit;
+        expected[std::string("MyClosestHitShader_AABB_InlineShadow") + variant] = ShaderStage::ClosestHit;
+        expected[std::string("InlineAmbientOcclusionCS") + variant] = ShaderStage::Compute;
+    }
     EXPECT_EQ(lib->exports().size(), expected.size());
     for (const auto& [name, stage] : expected) {
         const ShaderExport* e = lib->find(name);
         ASSERT_NE(e, nullptr) << name;
         EXPECT_EQ(e->stage, stage) << name;
+        // The RayQuery objects each export declares (the HLSL's template flags), and only those.
+        const bool traceShadowsInline = name.find("_InlineShadow") != std::string::npos;
+        const uint32_t acceptFirst =
+            name.find("_SearchAllHits") != std::string::npos ? 0u : uint32_t(RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH);
+        if (traceShadowsInline) {
+            EXPECT_EQ(e->rayQueryFlags,
+                      std::vector<uint32_t>{RAY_FLAG_CULL_BACK_FACING_TRIANGLES | RAY_FLAG_FORCE_OPAQUE | acceptFirst})
+                << name;
+        } else if (stage == ShaderStage::Compute) {
+            EXPECT_EQ(e->numThreads, uvec3(8, 8, 1)) << name;
+            EXPECT_EQ(e->rayQueryFlags,
+                      (std::vector<uint32_t>{RAY_FLAG_CULL_BACK_FACING_TRIANGLES, RAY_FLAG_CULL_BACK_FACING_TRIANGLES |
+                                                                                     RAY_FLAG_FORCE_OPAQUE | acceptFirst}))
+                << name;
+        } else if (stage != ShaderStage::Compute) {
+            EXPECT_TRUE(e->rayQueryFlags.empty()) << name;
+        }
     }
+    const ShaderExport* cs = lib->find("InlineAmbientOcclusionCS");
+    ASSERT_NE(cs, nullptr);
+    EXPECT_EQ(cs->numThreads, uvec3(8, 8, 1));  // [numthreads(8, 8, 1)]
+    EXPECT_EQ(cs->rayQueryFlags.size(), 2u);
 }
 
 TEST(D3D12Shaders, ExportsDeclareTheHlslPayloadAndAttributeTypes) {

@@ -127,7 +127,7 @@ TEST(StatsCli, RenderStatsPrintsAndWritesRayTypesExportsAndStageTimes) {
         seconds += member(s, "seconds").asNumber();
         shares += member(s, "share").asNumber();
     }
-    EXPECT_EQ(stageSeconds.size(), 7u);
+    EXPECT_EQ(stageSeconds.size(), 8u);  // the six shader stages, traversal, compute
     EXPECT_NEAR(seconds, member(times, "exclusiveSecondsSummedOverThreads").asNumber(), 1e-6);
     if (profiled) {
         EXPECT_NEAR(shares, 1.0, 1e-6);

@@ -1,7 +1,8 @@
 // DXR system values and RAY_FLAG constants under their HLSL names, as GL_EXT_ray_tracing built-ins, for GLSL ports
 // of D3D12 DXR HLSL. Not a port of one HLSL file. The including entry point defines its stage first:
-// DXR_STAGE_RAYGEN, DXR_STAGE_MISS, DXR_STAGE_CLOSEST_HIT, DXR_STAGE_ANY_HIT or DXR_STAGE_INTERSECTION
-// (each system value exists only in the stages DXR allows it in; GLSL rejects a built-in of another stage).
+// DXR_STAGE_RAYGEN, DXR_STAGE_MISS, DXR_STAGE_CLOSEST_HIT, DXR_STAGE_ANY_HIT or DXR_STAGE_INTERSECTION, or
+// DXR_STAGE_COMPUTE for a compute shader that traces inline (each system value exists only in the stages DXR allows
+// it in; GLSL rejects a built-in of another stage). A compute shader gets the RAY_FLAG_* constants only.
 #ifndef D3D12_DXR_INTRINSICS_GLSL
 #define D3D12_DXR_INTRINSICS_GLSL
 
@@ -16,9 +17,11 @@ const uint RAY_FLAG_CULL_FRONT_FACING_TRIANGLES = 0x20u;     // gl_RayFlagsCullF
 const uint RAY_FLAG_CULL_OPAQUE = 0x40u;                     // gl_RayFlagsCullOpaqueEXT
 const uint RAY_FLAG_CULL_NON_OPAQUE = 0x80u;                 // gl_RayFlagsCullNoOpaqueEXT
 
-// Every stage.
+// Every ray-tracing stage.
+#if !defined(DXR_STAGE_COMPUTE)
 uvec3 DispatchRaysIndex() { return gl_LaunchIDEXT; }
 uvec3 DispatchRaysDimensions() { return gl_LaunchSizeEXT; }
+#endif
 
 #if defined(DXR_STAGE_MISS) || defined(DXR_STAGE_CLOSEST_HIT) || defined(DXR_STAGE_ANY_HIT) || \
     defined(DXR_STAGE_INTERSECTION)

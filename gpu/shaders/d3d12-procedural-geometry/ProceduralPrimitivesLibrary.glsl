@@ -2,19 +2,22 @@
 // Samples/Desktop/D3D12Raytracing/src/D3D12RaytracingProceduralGeometry/ProceduralPrimitivesLibrary.hlsli.
 // An interface to call per geometry intersection tests based on as primitive type.
 // Needs RaytracingHlslCompat.glsl, the intrinsics files and RaytracingShaderHelper.glsl first. The analytic and
-// volumetric tests read RayTMin/RayTCurrent/RayFlags, so they exist in intersection (and hit) stages only; the
-// distance function exists everywhere.
+// volumetric tests read RayTMin/RayTCurrent/RayFlags, so they exist in intersection (and hit) stages only, and where
+// the includer traces inline and has made those three macros for the query's values (DXR_RAY_EXTENT_OF_QUERY,
+// InlineShadows.glsl); the distance function exists everywhere.
 #ifndef PROCEDURALPRIMITIVESLIBRARY_GLSL
 #define PROCEDURALPRIMITIVESLIBRARY_GLSL
 
-#if defined(DXR_STAGE_CLOSEST_HIT) || defined(DXR_STAGE_ANY_HIT) || defined(DXR_STAGE_INTERSECTION)
+#if defined(DXR_STAGE_CLOSEST_HIT) || defined(DXR_STAGE_ANY_HIT) || defined(DXR_STAGE_INTERSECTION) || \
+    defined(DXR_RAY_EXTENT_OF_QUERY)
 #include "d3d12-procedural-geometry/AnalyticPrimitives.glsl"
 #include "d3d12-procedural-geometry/VolumetricPrimitives.glsl"
 #endif
 #include "d3d12-procedural-geometry/SignedDistancePrimitives.glsl"
 #include "d3d12-procedural-geometry/SignedDistanceFractals.glsl"
 
-#if defined(DXR_STAGE_CLOSEST_HIT) || defined(DXR_STAGE_ANY_HIT) || defined(DXR_STAGE_INTERSECTION)
+#if defined(DXR_STAGE_CLOSEST_HIT) || defined(DXR_STAGE_ANY_HIT) || defined(DXR_STAGE_INTERSECTION) || \
+    defined(DXR_RAY_EXTENT_OF_QUERY)
 // Analytic geometry intersection test.
 // AABB local space dimensions: <-1,1>.
 // PORT: HLSL's enum parameter AnalyticPrimitive::Enum is a uint here.

@@ -1,7 +1,9 @@
 // Ports RaytracingShaderHelper.hlsli of microsoft/DirectX-Graphics-Samples@357ade6e,
 // Samples/Desktop/D3D12Raytracing/src/D3D12RaytracingProceduralGeometry/RaytracingShaderHelper.hlsli.
 // Needs common/d3d12_hlsl_intrinsics.glsl, common/d3d12_dxr_intrinsics.glsl and RaytracingHlslCompat.glsl first.
-// Functions that read a system value exist only in the stages DXR allows that value in (DXR_STAGE_* guards).
+// Functions that read a system value exist only in the stages DXR allows that value in (DXR_STAGE_* guards). IsCulled
+// and IsAValidHit also exist where the includer traces inline and has made RayTMin(), RayTCurrent() and RayFlags()
+// macros for the query's values (DXR_RAY_EXTENT_OF_QUERY, InlineShadows.glsl).
 #ifndef RAYTRACINGSHADERHELPER_GLSL
 #define RAYTRACINGSHADERHELPER_GLSL
 
@@ -50,9 +52,12 @@ bool IsInRange(in float val, in float min, in float max)
 #if defined(DXR_STAGE_CLOSEST_HIT) || defined(DXR_STAGE_ANY_HIT) || defined(DXR_STAGE_INTERSECTION)
 // Retrieve hit world position.
 // PORT: HLSL may call it in an intersection shader too; there RayTCurrent() is the closest committed t, as in DXR.
+// PORT: RayTCurrent() is written as what it is here, gl_RayTmaxEXT (common/d3d12_dxr_intrinsics.glsl), so that this
+// stays the shader's own hit also where a file that traces inline makes the intersection helpers' RayTCurrent() a
+// macro for the query's committed t (InlineShadows.glsl).
 vec3 HitWorldPosition()
 {
-    return WorldRayOrigin() + RayTCurrent() * WorldRayDirection();
+    return WorldRayOrigin() + gl_RayTmaxEXT * WorldRayDirection();
 }
 #endif
 
@@ -64,6 +69,7 @@ vec3 HitAttribute(vec3 vertexAttribute[3], vec2 barycentrics)
         barycentrics.y * (vertexAttribute[2] - vertexAttribute[0]);
 }
 
+#if !defined(DXR_STAGE_COMPUTE)
 // Generate a ray in world space for a camera pixel corresponding to an index from the dispatched 2D grid.
 Ray GenerateCameraRay(uvec2 index, in vec3 cameraPosition, in mat4 projectionToWorld)
 {
@@ -84,8 +90,10 @@ Ray GenerateCameraRay(uvec2 index, in vec3 cameraPosition, in mat4 projectionToW
 
     return ray;
 }
+#endif
 
-#if defined(DXR_STAGE_CLOSEST_HIT) || defined(DXR_STAGE_ANY_HIT) || defined(DXR_STAGE_INTERSECTION)
+#if defined(DXR_STAGE_CLOSEST_HIT) || defined(DXR_STAGE_ANY_HIT) || defined(DXR_STAGE_INTERSECTION) || \
+    defined(DXR_RAY_EXTENT_OF_QUERY)
 // Test if a hit is culled based on specified RayFlags.
 bool IsCulled(in Ray ray, in vec3 hitSurfaceNormal)
 {
@@ -112,6 +120,7 @@ vec2 TexCoords(in vec3 position)
     return position.xz;
 }
 
+#if !defined(DXR_STAGE_COMPUTE)
 // Calculate ray differentials.
 void CalculateRayDifferentials(out vec2 ddx_uv, out vec2 ddy_uv, in vec2 uv, in vec3 hitPosition, in vec3 surfaceNormal, in vec3 cameraPosition, in mat4 projectionToWorld)
 {
@@ -141,6 +150,7 @@ float AnalyticalCheckersTexture(in vec3 hitPosition, in vec3 surfaceNormal, in v
     CalculateRayDifferentials(ddx_uv, ddy_uv, uv, hitPosition, surfaceNormal, cameraPosition, projectionToWorld);
     return CheckersTextureBoxFilter(uv, ddx_uv, ddy_uv, 50);
 }
+#endif
 
 // Fresnel reflectance - schlick approximation.
 vec3 FresnelReflectanceSchlick(in vec3 I, in vec3 N, in vec3 f0)

@@ -6,7 +6,8 @@
 // More info here: http://www.iquilezles.org/www/articles/distfunctions/distfunctions.htm
 //
 // The functions the sample never calls (reference-scene-d3d12-procedural.md I10) are ported too, so the file reads
-// side by side with the HLSL. RaySignedDistancePrimitiveTest is for intersection shaders only (DXR_STAGE_ guard).
+// side by side with the HLSL. RaySignedDistancePrimitiveTest is for intersection shaders only (DXR_STAGE_ guard),
+// and for shaders that trace inline with the query's extent (DXR_RAY_EXTENT_OF_QUERY, InlineShadows.glsl).
 #ifndef SIGNEDDISTANCEPRIMITIVES_GLSL
 #define SIGNEDDISTANCEPRIMITIVES_GLSL
 
@@ -253,7 +254,8 @@ vec3 sdCalculateNormal(in vec3 pos, in uint sdPrimitive)
         e.xxx * GetDistanceFromSignedDistancePrimitive(pos + e.xxx, sdPrimitive));
 }
 
-#if defined(DXR_STAGE_CLOSEST_HIT) || defined(DXR_STAGE_ANY_HIT) || defined(DXR_STAGE_INTERSECTION)
+#if defined(DXR_STAGE_CLOSEST_HIT) || defined(DXR_STAGE_ANY_HIT) || defined(DXR_STAGE_INTERSECTION) || \
+    defined(DXR_RAY_EXTENT_OF_QUERY)
 // Test ray against a signed distance primitive.
 // Ref: https://www.scratchapixel.com/lessons/advanced-rendering/rendering-distance-fields/basic-sphere-tracer
 // PORT: GLSL has no default arguments (HLSL: stepScale = 1.0f); the only caller passes it.
