@@ -268,7 +268,8 @@ void writeQueryEvent(TextWriter& w, const SceneDesc& scene, const RecordedEvent&
             break;
         case Kind::Skipped: w.line(level + 2, "skipped by the system: " + r.note); break;
         case Kind::QueryProceed:
-            w.line(level, q + " Proceed() = " + (e.accepted ? std::string("TRUE") : std::string("FALSE")) + ": " + r.note +
+            // The note starts with the result ("TRUE: a procedural candidate ...").
+            w.line(level, q + " Proceed() = " + (r.note.empty() ? std::string(e.accepted ? "TRUE" : "FALSE") : r.note) +
                               (e.accepted ? " (" + hitText(scene, e) + (e.procedural ? ", box entry t = " : ", t = ") + shortestFloat(e.t) + ")"
                                           : "; CommittedRayT = " + shortestFloat(e.t) +
                                                 (e.committed ? "" : " (COMMITTED_NOTHING: TMax)")));

@@ -170,5 +170,25 @@ TEST(Explain, PayloadsAreDecodedFieldByField) {
     EXPECT_EQ(describePayload("SomethingElse", bytes), "0x3F800000 0x7");
 }
 
+// RQ-12, RQ-14, RQ-20, RQ-22: the AO compute scene at 640x360, pixel (288, 203) (docs/ray-query.md): the primary
+// query is handed the volumetric primitive's box, the shader commits its hit, and the ground's triangle behind it
+// is skipped by the system. Each Proceed line says its result once.
+TEST(Explain, RQ_22_AComputeThreadsPrimaryQueryStepByStep) {
+    auto scene = loadScene(std::string(REFRAY_SOURCE_DIR) + "/scenes/inline-ambient-occlusion.json");
+    const Explanation x = explainPixel(*scene, small(640, 360), 288, 203);
+    ASSERT_FALSE(x.error) << x.error->format();
+    const std::string text = formatExplanation(x, scene->desc());
+    EXPECT_CONTAINS(text, "RayQuery #1 in compute shader 'InlineAmbientOcclusionCS': TraceRayInline");
+    EXPECT_CONTAINS(text, "RayQuery #1 Proceed() = TRUE: a procedural candidate for the shader (instance 1 'primitives' "
+                          "(InstanceID 0), geometry 2, primitive 0, box entry t = ");
+    EXPECT_CONTAINS(text, "RayQuery #1 commit: CommitProceduralPrimitiveHit (RQ-22): instance 1 'primitives' "
+                          "(InstanceID 0), geometry 2, primitive 0, CommittedRayT = ");
+    EXPECT_CONTAINS(text, "skipped by the system: t outside (RayTMin, CommittedRayT)");
+    EXPECT_CONTAINS(text, "RayQuery #1 Proceed() = FALSE: the search is finished; CommittedRayT = ");
+    EXPECT_CONTAINS(text, "RayQuery #9 in compute shader");
+    EXPECT_EQ(text.find("TRUE: TRUE"), std::string::npos) << text;
+    EXPECT_EQ(text.find("FALSE: FALSE"), std::string::npos) << text;
+}
+
 }  // namespace
 }  // namespace refray::scenes

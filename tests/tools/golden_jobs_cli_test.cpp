@@ -112,6 +112,27 @@ TEST(GoldenDiscriminateCli, RunsOneCandidateAndNamesAnUnknownOne) {
     r = runRefray("golden discriminate " + dir.string() + " --only no-such-bug");
     EXPECT_EQ(r.status, 2) << r.output;
     EXPECT_TRUE(contains(r.output, "no discrimination candidate named 'no-such-bug'")) << r.output;
+    // --golden: only the goldens named, and an unknown one is named.
+    r = runRefray("golden discriminate " + dir.string() + " --golden no-such-golden --only double");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "no golden named 'no-such-golden'")) << r.output;
+}
+
+// The RayQuery mutants on the inline-shadow golden (tests/golden): procedural candidates ignored fails it, a commit
+// outside [RayTMin, CommittedRayT] is stopped by RQ-22 before an image exists.
+TEST(GoldenDiscriminateCli, RayQueryMutantsOnTheInlineShadowGolden) {
+    const fs::path dir = refray::testing::freshDirectory("golden-jobs", "discriminate-rq");
+    auto r = runRefray("golden discriminate " + std::string(REFRAY_SOURCE_DIR) + "/tests/golden --root " +
+                       std::string(REFRAY_SOURCE_DIR) +
+                       " --golden d3d12-procedural-geometry-inline.default --only rq-procedural-ignored,"
+                       "rq-commit-outside-range --markdown " + (dir / "report.md").string());
+    EXPECT_EQ(r.status, 0) << r.output;
+    const std::string report = fileText(dir / "report.md");
+    EXPECT_TRUE(contains(report, "| `rq-procedural-ignored` | mutant | FAILURE")) << report;
+    EXPECT_TRUE(contains(report, "| `rq-commit-outside-range` | mutant | render error |")) << report;
+    EXPECT_TRUE(contains(r.output, "error RQ-22: CommitProceduralPrimitiveHit() was given a t outside [RayTMin, "
+                                   "CommittedRayT]")) << r.output;
+    EXPECT_FALSE(contains(report, "inline-ambient-occlusion")) << report;
 }
 
 }  // namespace
