@@ -310,8 +310,8 @@ bool RayQueryObject::Proceed() {
         e.accepted = result;
         if (result) detail::setQueryHit(e, q.candidate);
         e.committed = q.status != COMMITTED_NOTHING;
-        e.note = result ? (q.candidate.procedural ? "TRUE: a procedural candidate for the shader"
-                                                  : "TRUE: a non-opaque triangle candidate for the shader")
+        e.note = result ? (q.candidate.procedural ? "TRUE: a procedural candidate for the shader to intersect"
+                                                  : "TRUE: a non-opaque triangle candidate for the shader to accept or not")
                         : (q.searchEnded ? "FALSE: ACCEPT_FIRST_HIT_AND_END_SEARCH ended the search after a commit"
                                          : "FALSE: the search is finished");
         e.t = result ? q.candidate.t : q.rs.tCurrent;
