@@ -203,6 +203,20 @@ void collectResults(ThreadStates& threadStates, const DispatchRaysDesc& desc, Di
     }
 }
 
+// What DispatchRays and Dispatch share of their state: the device, the bound pipeline and arguments, the launch grid
+// (`grid` outlives the dispatch) and the options.
+void initDispatchState(DispatchState& ds, Device* device, const GpuMemory& memory, const StateObjectPtr& pipeline,
+                       const DispatchRaysDesc& grid, const GlobalRootArguments* global, const DispatchOptions& options,
+                       uint64_t epoch) {
+    ds.device = device;
+    ds.memory = &memory;
+    ds.pipeline = pipeline.get();
+    ds.desc = &grid;
+    ds.global = global;
+    ds.options = options;
+    ds.epoch = epoch;
+}
+
 // Runs every launch of `region` on per-thread states and merges their diagnostics and statistics into `result`.
 void runLaunches(DispatchState& ds, const LaunchRegion& region, DispatchResult& result) {
     ThreadStates threadStates([&] {
@@ -227,13 +241,7 @@ DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObj
     checkGlobalArguments(globalArguments);
 
     DispatchState ds;
-    ds.device = this;
-    ds.memory = &memory_;
-    ds.pipeline = pipeline.get();
-    ds.desc = &desc;
-    ds.global = globalArguments;
-    ds.options = options;
-    ds.epoch = epoch_.load();
+    initDispatchState(ds, this, memory_, pipeline, desc, globalArguments, options, epoch_.load());
     for (const ProgramEntry& entry : pipeline->entries())
         if (entry.anyHit) ds.anyHitInPipeline = true;
     resolveRayGenerationRecord(ds);
@@ -276,13 +284,7 @@ DispatchResult Device::dispatch(const DispatchDesc& desc, const StateObjectPtr& 
     const LaunchRegion region = launchRegion(grid, options);
 
     DispatchState ds;
-    ds.device = this;
-    ds.memory = &memory_;
-    ds.pipeline = pipeline.get();
-    ds.desc = &grid;
-    ds.global = globalArguments;
-    ds.options = options;
-    ds.epoch = epoch_.load();
+    initDispatchState(ds, this, memory_, pipeline, grid, globalArguments, options, epoch_.load());
     ds.computeShader = shader;
 
     DispatchResult result;

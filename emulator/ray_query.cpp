@@ -91,6 +91,16 @@ DiagnosticBuilder stateDiag(const RayQueryState& q, const char* rule, const std:
 
 void raiseQuery(const RayQueryState& q, const Diagnostic& d) { raise(threadOf(q), siteOf(*q.inv), d); }
 
+// IS-10: an intersection shader registered with ReportHitEnd::Return uses nothing after a ReportHit that ended the
+// search, its queries included.
+void requireLive(const RayQueryState& q, const char* call) {
+    if (q.inv->searchEnded) [[unlikely]]
+        stageError(*q.inv, "IS-10",
+                   "intersection shader '" + q.inv->shader->name + "' is registered with ReportHitEnd::Return (each "
+                       "ReportHit is its last action) but called RayQuery::" + call + "() after a ReportHit that "
+                       "ended the search");
+}
+
 // A use DXR defines and SPIR-V does not (18e): a note, counted per kind (NoteTally).
 enum class SpirvUndefined : uint8_t { ProceedAfterFalse, AbortWithoutCandidate, CommittedRayTOfNothing };
 
@@ -235,6 +245,7 @@ RayQueryObject::RayQueryObject(ShaderContext& ctx, uint32_t templateRayFlags, ui
 
 void RayQueryObject::TraceRayInline(GpuVirtualAddress as, uint32_t rayFlags, uint32_t mask, const RayDesc& ray) {
     RayQueryState& q = *state_;
+    detail::requireLive(q, "TraceRayInline");
     detail::ThreadState& ts = detail::threadOf(q);
     const detail::Site site = detail::siteOf(*q.inv);
     // RQ-9: whatever the state, the current query is discarded.
@@ -293,6 +304,7 @@ void RayQueryObject::TraceRayInline(GpuVirtualAddress as, uint32_t rayFlags, uin
 
 bool RayQueryObject::Proceed() {
     RayQueryState& q = *state_;
+    detail::requireLive(q, "Proceed");
     detail::ThreadState& ts = detail::threadOf(q);
     bool result = false;
     if (q.phase == QueryPhase::Fresh) {
@@ -312,8 +324,8 @@ bool RayQueryObject::Proceed() {
         e.accepted = result;
         if (result) detail::setQueryHit(e, q.candidate);
         e.committed = q.status != COMMITTED_NOTHING;
-        e.note = result ? (q.candidate.procedural ? "TRUE: a procedural candidate for the shader"
-                                                  : "TRUE: a non-opaque triangle candidate for the shader")
+        e.note = result ? (q.candidate.procedural ? "TRUE: a procedural candidate for the shader to intersect"
+                                                  : "TRUE: a non-opaque triangle candidate for the shader to accept or not")
                         : (q.searchEnded ? "FALSE: ACCEPT_FIRST_HIT_AND_END_SEARCH ended the search after a commit"
                                          : "FALSE: the search is finished");
         e.t = result ? q.candidate.t : q.rs.tCurrent;
@@ -324,6 +336,7 @@ bool RayQueryObject::Proceed() {
 
 void RayQueryObject::Abort() {
     RayQueryState& q = *state_;
+    detail::requireLive(q, "Abort");
     if (q.phase == QueryPhase::Fresh) {
         detail::raiseQuery(q, detail::stateDiag(q, "RQ-19", "Abort", "was called before TraceRayInline"));
         return;
@@ -347,6 +360,7 @@ namespace {
 // The candidate, or null after reporting a call outside Proceed() == TRUE (RQ-17, RQ-28); `triangleOnly` for the
 // getters of triangle candidates.
 const detail::QueryHit* candidateFor(const RayQueryState& q, const char* call, bool triangleOnly) {
+    detail::requireLive(q, call);
     if (q.phase != QueryPhase::Candidate) {
         detail::raiseQuery(q, detail::stateDiag(q, q.phase == QueryPhase::Fresh ? "RQ-19" : "RQ-28", call,
                                                 "is valid only after Proceed() returned TRUE"));
@@ -362,6 +376,7 @@ const detail::QueryHit* candidateFor(const RayQueryState& q, const char* call, b
 
 // The committed hit, or null after reporting a call the third table does not list for the status (RQ-29).
 const detail::QueryHit* committedFor(const RayQueryState& q, const char* call, bool triangleOnly) {
+    detail::requireLive(q, call);
     if (q.phase == QueryPhase::Fresh || q.phase == QueryPhase::Initialised) {
         detail::raiseQuery(q, detail::stateDiag(q, "RQ-29", call, "is valid only after Proceed() has been called"));
         return nullptr;
@@ -379,6 +394,7 @@ const detail::QueryHit* committedFor(const RayQueryState& q, const char* call, b
 // The six getters of RQ-25: valid once Proceed has been called; before it (after TraceRayInline) a warning "not in
 // the table"; before TraceRayInline an error.
 void checkQueryGetter(const RayQueryState& q, const char* call) {
+    detail::requireLive(q, call);
     if (q.phase == QueryPhase::Fresh)
         detail::raiseQuery(q, detail::stateDiag(q, "RQ-19", call, "was called before TraceRayInline"));
     else if (!q.proceeded && q.phase == QueryPhase::Initialised)
@@ -495,6 +511,7 @@ void RayQueryObject::CommitProceduralPrimitiveHit(float tHit) {
 
 uint32_t RayQueryObject::CommittedStatus() const {
     const RayQueryState& q = *state_;
+    detail::requireLive(q, "CommittedStatus");
     if (q.phase == QueryPhase::Fresh)  // RQ-18: valid any time after TraceRayInline
         detail::raiseQuery(q, detail::stateDiag(q, "RQ-19", "CommittedStatus", "was called before TraceRayInline"));
     return q.status;

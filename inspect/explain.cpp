@@ -3,6 +3,7 @@
 #include <cinttypes>
 #include <cstdio>
 #include <cstring>
+#include <map>
 #include <sstream>
 
 #include "core/error.h"
@@ -268,8 +269,7 @@ void writeQueryEvent(TextWriter& w, const SceneDesc& scene, const RecordedEvent&
             break;
         case Kind::Skipped: w.line(level + 2, "skipped by the system: " + r.note); break;
         case Kind::QueryProceed:
-            // The note starts with the result ("TRUE: a procedural candidate ...").
-            w.line(level, q + " Proceed() = " + (r.note.empty() ? std::string(e.accepted ? "TRUE" : "FALSE") : r.note) +
+            w.line(level, q + " Proceed() = " + r.note +
                               (e.accepted ? " (" + hitText(scene, e) + (e.procedural ? ", box entry t = " : ", t = ") + shortestFloat(e.t) + ")"
                                           : "; CommittedRayT = " + shortestFloat(e.t) +
                                                 (e.committed ? "" : " (COMMITTED_NOTHING: TMax)")));
@@ -288,16 +288,33 @@ std::string formatExplanation(const Explanation& x, const SceneDesc& scene) {
     TextWriter w;
     w.line(0, "refray explain: scene '" + x.scene + "', camera '" + x.camera + "', " + std::to_string(x.width) + "x" +
                   std::to_string(x.height) + ", time " + x.time + ", " + x.precision + " shaders");
-    w.line(0, "pixel (" + std::to_string(x.x) + ", " + std::to_string(x.y) + ") = DispatchRaysIndex (" +
-                  std::to_string(x.x) + ", " + std::to_string(x.y) + ", 0)");
+    if (scene.computeShader.empty())
+        w.line(0, "pixel (" + std::to_string(x.x) + ", " + std::to_string(x.y) + ") = DispatchRaysIndex (" +
+                      std::to_string(x.x) + ", " + std::to_string(x.y) + ", 0)");
+    else
+        w.line(0, "pixel (" + std::to_string(x.x) + ", " + std::to_string(x.y) + ") = SV_DispatchThreadID (" +
+                      std::to_string(x.x) + ", " + std::to_string(x.y) + ", 0) of a compute dispatch of '" +
+                      scene.computeShader + "' (no shader table, no TraceRay: it traces inline)");
     uint32_t rayNumber = 0;
     std::vector<uint32_t> rayStack;  // ray numbers of the TraceRays in flight
+    // Per query: the level of its lines, and whether the shader was handed a candidate it has not committed yet.
+    std::map<uint32_t, std::pair<uint32_t, bool>> undecided;
+    auto closeDecision = [&](uint32_t query) {
+        auto it = undecided.find(query);
+        if (it == undecided.end() || !it->second.second) return;
+        w.line(it->second.first + 1, "RayQuery #" + std::to_string(query) + " the shader's decision: no commit for this candidate");
+        it->second.second = false;
+    };
     for (const RecordedEvent& r : x.events) {
         const TraceEvent& e = r.event;
         // Levels: a TraceRay of depth d at 3d-2, its details at 3d-1, what it runs at 3d, inside those at 3d+1.
         const uint32_t base = e.depth == 0 ? 0 : 3 * e.depth - 1;
         if (e.queryId != 0) {  // a RayQuery's life, inside the shader that owns it
-            writeQueryEvent(w, scene, r, base + (e.depth == 0 ? 1 : 2));
+            const uint32_t level = base + (e.depth == 0 ? 1 : 2);
+            if (e.kind != Kind::QueryCommit) closeDecision(e.queryId);
+            if (e.kind == Kind::QueryCommit) undecided[e.queryId].second = false;
+            writeQueryEvent(w, scene, r, level);
+            if (e.kind == Kind::QueryProceed) undecided[e.queryId] = {level, e.accepted};
             continue;
         }
         switch (e.kind) {
@@ -306,7 +323,9 @@ std::string formatExplanation(const Explanation& x, const SceneDesc& scene) {
                 if (e.stage == dxr::ShaderStage::RayGeneration) {
                     w.line(0, stage + " shader '" + r.exportName + "' (ray generation record at " + hexText(e.recordAddress) + ")");
                 } else {
-                    w.line(base + 1, stage + " shader '" + r.exportName + "' runs (record " + std::to_string(e.recordIndex) + ")");
+                    w.line(base + 1, stage + " shader '" + r.exportName + "' runs" +
+                                         (e.stage == dxr::ShaderStage::Compute ? std::string(" (no record)")
+                                                                               : " (record " + std::to_string(e.recordIndex) + ")"));
                 }
                 break;
             }

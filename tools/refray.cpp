@@ -53,8 +53,12 @@ using tools::writeOutput;
 void printStats(const scenes::RenderResult& r, const Size& size) {
     const dxr::DispatchStats& st = r.dispatch.stats;
     const auto u = [](uint64_t v) { return (unsigned long long)v; };
-    std::printf("render: %ux%u in %.3f s, %llu rays (%.0f rays/s)\n", size.width, size.height, r.dispatch.seconds,
+    std::printf("render: %ux%u in %.3f s, %llu rays (%.0f rays/s)", size.width, size.height, r.dispatch.seconds,
                 u(st.raysTraced), r.dispatch.seconds > 0 ? double(st.raysTraced) / r.dispatch.seconds : 0.0);
+    if (st.rayQueries)
+        std::printf(", %llu ray queries (%.0f/s)", u(st.rayQueries),
+                    r.dispatch.seconds > 0 ? double(st.rayQueries) / r.dispatch.seconds : 0.0);
+    std::printf("\n");
     for (size_t d = 1; d < st.raysPerDepth.size(); ++d) std::printf("  rays at depth %zu: %llu\n", d, u(st.raysPerDepth[d]));
 
     // Ray types x depth.
@@ -388,8 +392,7 @@ int runRender(const RenderOptions& o) {
     }
     for (const auto& w : result.dispatch.diagnostics.warnings()) std::fprintf(stderr, "%s\n", w.format().c_str());
     // Notes: uses DXR defines that SPIR-V does not (RayQuery, docs/ray-query.md); they never fail a render.
-    for (const auto& n : result.dispatch.diagnostics.notes())
-        std::fprintf(stderr, "%s (%llu times)\n", n.format().c_str(), (unsigned long long)n.count);
+    for (const auto& n : result.dispatch.diagnostics.notes()) std::fprintf(stderr, "%s\n", n.format().c_str());
     if (statistics) {
         statistics->mean.metadata["refray_version"] = tools::kVersion;
         statistics->mean.metadata["refray_commit"] = tools::kCommit;

@@ -2054,3 +2054,42 @@ TEST(ComputeDispatch, RQ_13_QueriesGiveTheSameResultsOnAnyNumberOfThreads) {
 
 }  // namespace
 }  // namespace refray::test
+
+namespace refray::test {
+namespace {
+
+using namespace dispatch_rig;
+
+// IS-10 with queries: an intersection shader registered with ReportHitEnd::Return promises its ReportHit is its last
+// action; a RayQuery it made before that ReportHit may not be used after a ReportHit that ended the search.
+TEST(RayQuery, IS_10_AQueryUsedAfterAnEndingReportHitBreaksTheReturnPromise) {
+    Rig r;
+    const GpuVirtualAddress target = r.h.tlas({Harness::instance(r.h.blas({r.h.triangles(triAt(10))}))});
+    r.h.tlas({Harness::instance(r.h.blas({r.h.aabbs({unitBox()})}))});  // entered at t = 4
+    r.h.library->declareRayQueries("IS_R", {RAY_FLAG_NONE});
+    bool usedAfter = false;
+    r.is = [&, target](ShaderContext& ctx) {
+        RayQuery<RAY_FLAG_NONE> q(ctx);
+        q.TraceRayInline(target, RAY_FLAG_NONE, 0xFF, zRay());
+        while (q.Proceed()) {
+        }
+        const bool keepsGoing = ctx.ReportHit(4.0f, 3, ProbeAttributes{});  // ends the search: ACCEPT_FIRST_HIT
+        if (keepsGoing) {
+            usedAfter = true;
+            (void)q.CommittedStatus();  // the broken promise
+        }
+    };
+    r.args.flags = RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH;
+    r.build();
+    try {
+        r.run({"HG_BoxR_noAH"});
+        FAIL() << "the query call after the ending ReportHit must stop the dispatch";
+    } catch (const DxrError& e) {
+        EXPECT_EQ(e.diagnostic().ruleId, "IS-10");
+        EXPECT_NE(std::string(e.what()).find("RayQuery::CommittedStatus()"), std::string::npos) << e.what();
+    }
+    EXPECT_TRUE(usedAfter);
+}
+
+}  // namespace
+}  // namespace refray::test
