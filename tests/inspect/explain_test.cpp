@@ -179,7 +179,7 @@ TEST(Explain, RQ_22_AComputeThreadsPrimaryQueryStepByStep) {
     ASSERT_FALSE(x.error) << x.error->format();
     const std::string text = formatExplanation(x, scene->desc());
     EXPECT_CONTAINS(text, "RayQuery #1 in compute shader 'InlineAmbientOcclusionCS': TraceRayInline");
-    EXPECT_CONTAINS(text, "RayQuery #1 Proceed() = TRUE: a procedural candidate for the shader (instance 1 'primitives' "
+    EXPECT_CONTAINS(text, "RayQuery #1 Proceed() = TRUE: a procedural candidate for the shader to intersect (instance 1 'primitives' "
                           "(InstanceID 0), geometry 2, primitive 0, box entry t = ");
     EXPECT_CONTAINS(text, "RayQuery #1 commit: CommitProceduralPrimitiveHit (RQ-22): instance 1 'primitives' "
                           "(InstanceID 0), geometry 2, primitive 0, CommittedRayT = ");
