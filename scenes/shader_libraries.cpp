@@ -88,6 +88,15 @@ ShaderLibraryFacts d3d12Facts() {
         {E::DistanceFog, "MyClosestHitShader_AABB_InlineShadow", "", "", 0.0f},
         {E::RayDifferentials, "MyClosestHitShader_Triangle_InlineShadow", "the grid lines", "", 0.0f},
     };
+    // The variants of the inline-shadow closest hits (the RayQuery lessons and mutants) have the same effects.
+    const size_t inlineUses = f.uses.size();
+    for (const std::string& suffix : d::inlineVariantSuffixes())
+        for (size_t i = 0; i < inlineUses; ++i)
+            if (f.uses[i].exportName.ends_with("_InlineShadow")) {
+                ShaderEffectUse use = f.uses[i];
+                use.exportName += suffix;
+                f.uses.push_back(use);
+            }
     return f;
 }
 

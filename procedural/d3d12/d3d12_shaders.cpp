@@ -846,6 +846,13 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
 
 }  // namespace
 
+std::vector<std::string> inlineVariantSuffixes() {
+    std::vector<std::string> out;
+    for (const InlineVariant v : kInlineVariants)
+        if (v != InlineVariant::AsWritten) out.push_back(inlineVariantSuffix(v));
+    return out;
+}
+
 std::shared_ptr<ShaderLibrary> makeD3D12ShaderLibrary(Precision precision, const TraceRayArgumentSet& traceRay,
                                                       const Accuracy& accuracy, const Effects& effects,
                                                       const std::optional<Perturbation>& perturbation) {

@@ -178,6 +178,10 @@ std::vector<dxr::HitGroupDesc> d3d12HitGroups();
 // The hit groups that take the "Triangle" local root signature, and those that take "AABB".
 std::vector<std::string> triangleHitGroupNames();
 std::vector<std::string> aabbHitGroupNames();
+// The suffixes of the inline-tracing exports' variants (InlineVariant in d3d12_shaders.cpp: "_IgnoreProcedural",
+// ...): MyClosestHitShader_{Triangle,AABB}_InlineShadow<suffix> and InlineAmbientOcclusionCS<suffix> are exports of
+// the library, for the RayQuery lessons and discrimination mutants.
+std::vector<std::string> inlineVariantSuffixes();
 
 // ---- The shader library -------------------------------------------------------------------------------
 

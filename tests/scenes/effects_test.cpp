@@ -103,6 +103,20 @@ TEST(EffectSet, D3D12SceneFieldByField) {
     EXPECT_EQ(e.pipelineRecursionDepth, 3u);
 }
 
+// The RayQuery lessons' variant closest hits (procedural/d3d12 InlineVariant) have the effects of the closest hits
+// they vary: shadow rays (traced inline), reflections, fog and the grid lines.
+TEST(EffectSet, TheInlineVariantsHaveTheEffectsOfTheShadersTheyVary) {
+    const EffectSet e = computeEffects(loadSceneFile(kSourceDir + "/scenes/lessons/accept-first-hit-for-shadows.json"));
+    EXPECT_TRUE(e.shadowRays.on) << e.shadowRays.reason;
+    EXPECT_NE(e.shadowRays.reason.find("MyClosestHitShader_Triangle_InlineShadow_SearchAllHits, "
+                                       "MyClosestHitShader_AABB_InlineShadow_SearchAllHits trace 'Shadow' rays"),
+              std::string::npos)
+        << e.shadowRays.reason;
+    EXPECT_TRUE(e.reflections.on) << e.reflections.reason;
+    EXPECT_TRUE(e.distanceFog.on) << e.distanceFog.reason;
+    EXPECT_TRUE(e.rayDifferentials.on) << e.rayDifferentials.reason;
+}
+
 // A pipeline flag skips the geometry type no ray reaches, unless a ray type's flags make it undefined. The Cornell
 // box's pipeline gets SKIP_PROCEDURAL_PRIMITIVES; PathTracerSceneFile.* checks its render is bit-identical to the
 // C++-built twin, whose pipeline has no flags.
