@@ -93,6 +93,15 @@ bool IntersectCandidateProceduralPrimitive(rayQueryEXT q, RayQueryState qs, out 
     return hit;
 }
 
+// The lesson variants (scenes/lessons/, InlineVariant in procedural/d3d12/d3d12_shaders.cpp) are the same closest hits
+// compiled with one of these defined: INLINE_VARIANT_SEARCH_ALL_HITS drops ACCEPT_FIRST_HIT_AND_END_SEARCH from the
+// shadow query, INLINE_VARIANT_IGNORE_PROCEDURAL never intersects its procedural candidates.
+#ifdef INLINE_VARIANT_SEARCH_ALL_HITS
+#define INLINE_SHADOW_QUERY_FLAGS (RAY_FLAG_CULL_BACK_FACING_TRIANGLES | RAY_FLAG_FORCE_OPAQUE)
+#else
+#define INLINE_SHADOW_QUERY_FLAGS (RAY_FLAG_CULL_BACK_FACING_TRIANGLES | RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH)
+#endif
+
 // TraceShadowRayAndReportIfHit, traced inline.
 bool TraceShadowRayInlineAndReportIfHit(in Ray ray, in uint currentRayRecursionDepth)
 {
@@ -115,11 +124,12 @@ bool TraceShadowRayInlineAndReportIfHit(in Ray ray, in uint currentRayRecursionD
     // overrides an inline query's arguments).
     rayQueryEXT q;
     RayQueryState qs = RayQuery_TraceRayInline(q, g_scene,
-        RAY_FLAG_CULL_BACK_FACING_TRIANGLES | RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH,
+        INLINE_SHADOW_QUERY_FLAGS,
         RAY_FLAG_NONE, TraceRayParameters_InstanceMask, rayDesc);
     while (RayQuery_Proceed(q, qs))
     {
         // FORCE_OPAQUE: the ground plane's triangles are committed inside Proceed (RQ-14) and never get here.
+#ifndef INLINE_VARIANT_IGNORE_PROCEDURAL  // LESSON: without this branch no procedural candidate is intersected
         if (RayQuery_CandidateType(q) == CANDIDATE_PROCEDURAL_PRIMITIVE)
         {
             float thit;
@@ -129,6 +139,7 @@ bool TraceShadowRayInlineAndReportIfHit(in Ray ray, in uint currentRayRecursionD
                 RayQuery_CommitProceduralPrimitiveHit(q, thit);  // ACCEPT_FIRST_HIT_AND_END_SEARCH: the next Proceed returns false
             }
         }
+#endif
     }
     return RayQuery_CommittedStatus(q) != COMMITTED_NOTHING;
 }
