@@ -123,6 +123,14 @@ echo "slurm: controller and node up ($host, $cpus CPUs, ports $ctld_port/$slurmd
 
 # The plan and its job lines.
 cd "$root"
+# The scenes: a root holding two of the repository's scene files, one that renders with DispatchRays and one with a
+# compute dispatch (every kind of job an update plans), keeps the check short; REFRAY_SLURM_ALL_SCENES=1 takes them all.
+if [ "${REFRAY_SLURM_ALL_SCENES:-0}" != 1 ]; then
+  mkdir -p "$work/root/scenes"
+  cp "$root/scenes/d3d12-procedural-geometry.json" "$root/scenes/inline-ambient-occlusion.json" "$work/root/scenes/" ||
+    fail "cannot copy the scene files"
+  root=$work/root
+fi
 "$refray" golden update --size "$size" --dir "$work/slurm-goldens" --root "$root" --emit-jobs "$work/jobs.txt" ||
   fail "refray golden update --emit-jobs"
 lines=$(wc -l < "$work/jobs.txt")
