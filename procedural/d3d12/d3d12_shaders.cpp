@@ -459,20 +459,17 @@ bool IntersectCandidateProceduralPrimitive(const ShaderContext& ctx, const RayQu
     return true;
 }
 
-// TraceShadowRayAndReportIfHit, traced inline: procedural candidates are intersected here and committed; the ground
-// plane's triangles are opaque (FORCE_OPAQUE) and committed inside Proceed (RQ-14).
+// TraceAnyHitInline: true when the ray from origin along direction meets a surface in [0, tMax]. Procedural
+// candidates are intersected here and committed; the ground plane's triangles are opaque (FORCE_OPAQUE) and
+// committed inside Proceed (RQ-14). The shadow rays' query, which the AO occlusion rays trace too.
 // PORT: RayQuery<kInlineShadowQueryFlags> q; the object is made with the variant's template flags
 // (inlineShadowQueryFlags), which for AsWritten are kInlineShadowQueryFlags.
+// PORT: TraceRayParameters::InstanceMask is the library's shadow-ray mask, as in the TraceRay version.
 template <typename T>
-bool TraceShadowRayInlineAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
-                                        const Effects& effects, const Accuracy& accuracy, const tvec3<T>& origin,
-                                        const tvec3<T>& direction, uint32_t currentRayRecursionDepth,
-                                        InlineVariant variant = InlineVariant::AsWritten) {
-    if (currentRayRecursionDepth >= maxDepth) return false;
-    if (!kShadowMachinery || !effects.traceShadowRays) return false;  // PORT: shadows switched off (procedural/effects.h)
-    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
+bool TraceAnyHitInline(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                       const tvec3<T>& origin, const tvec3<T>& direction, float tMax, InlineVariant variant) {
+    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), tMax};
     RayQueryObject q(ctx, inlineShadowQueryFlags(variant), RAYQUERY_FLAG_NONE);
-    // PORT: TraceRayParameters::InstanceMask is the library's shadow-ray mask, as in the TraceRay version.
     q.TraceRayInline(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_NONE,
                      traceRay[RayType::Shadow].instanceInclusionMask, rayDesc);
     while (q.Proceed()) {
@@ -485,6 +482,17 @@ bool TraceShadowRayInlineAndReportIfHit(ShaderContext& ctx, const TraceRayArgume
         }
     }
     return q.CommittedStatus() != COMMITTED_NOTHING;
+}
+
+// TraceShadowRayAndReportIfHit, traced inline: TMax 10000, as the TraceRay version.
+template <typename T>
+bool TraceShadowRayInlineAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
+                                        const Effects& effects, const Accuracy& accuracy, const tvec3<T>& origin,
+                                        const tvec3<T>& direction, uint32_t currentRayRecursionDepth,
+                                        InlineVariant variant = InlineVariant::AsWritten) {
+    if (currentRayRecursionDepth >= maxDepth) return false;
+    if (!kShadowMachinery || !effects.traceShadowRays) return false;  // PORT: shadows switched off (procedural/effects.h)
+    return TraceAnyHitInline(ctx, traceRay, accuracy, origin, direction, 10000.0f, variant);
 }
 
 // How a closest hit traces its shadow ray: TraceRay (the sample) or a RayQuery (InlineShadows.hlsl).
@@ -689,26 +697,12 @@ bool TracePrimaryInline(ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
     return true;
 }
 
-// True when the occlusion ray meets any surface within AO_RADIUS.
-// PORT: RayQuery<kInlineShadowQueryFlags> q, as in TraceShadowRayInlineAndReportIfHit.
+// True when the occlusion ray meets any surface within AO_RADIUS: the shadow rays' query.
 template <typename T>
 bool TraceOcclusionInline(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
                           const tvec3<T>& origin, const tvec3<T>& direction,
                           InlineVariant variant = InlineVariant::AsWritten) {
-    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), AO_RADIUS};
-    RayQueryObject q(ctx, inlineShadowQueryFlags(variant), RAYQUERY_FLAG_NONE);
-    q.TraceRayInline(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_NONE,
-                     traceRay[RayType::Shadow].instanceInclusionMask, rayDesc);
-    while (q.Proceed()) {
-        if (q.CandidateType() == CANDIDATE_PROCEDURAL_PRIMITIVE) {
-            if (variant == InlineVariant::IgnoreProcedural) continue;  // LESSON: the candidate is never intersected
-            T thit;
-            tvec3<T> normal;
-            if (IntersectCandidateProceduralPrimitive<T>(ctx, q, accuracy, thit, normal, rayDesc.TMax, variant))
-                q.CommitProceduralPrimitiveHit(float(thit));
-        }
-    }
-    return q.CommittedStatus() != COMMITTED_NOTHING;
+    return TraceAnyHitInline(ctx, traceRay, accuracy, origin, direction, AO_RADIUS, variant);
 }
 
 // [numthreads(8, 8, 1)] InlineAmbientOcclusionCS: one thread per pixel; threads past the render target's edge return.

@@ -104,30 +104,10 @@ bool TracePrimaryInline(float3 origin, float3 direction, out float3 hitPosition,
     return true;
 }
 
-// True when the occlusion ray finds any surface within AO_RADIUS.
+// True when the occlusion ray finds any surface within AO_RADIUS: the shadow rays' query (InlineShadows.hlsl).
 bool TraceOcclusionInline(float3 origin, float3 direction)
 {
-    RayDesc rayDesc;
-    rayDesc.Origin = origin;
-    rayDesc.Direction = direction;
-    rayDesc.TMin = 0;
-    rayDesc.TMax = AO_RADIUS;
-
-    RayQuery<RAY_FLAG_CULL_BACK_FACING_TRIANGLES | RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH> q;
-    q.TraceRayInline(g_scene, RAY_FLAG_NONE, TraceRayParameters::InstanceMask, rayDesc);
-    while (q.Proceed())
-    {
-        if (q.CandidateType() == CANDIDATE_PROCEDURAL_PRIMITIVE)
-        {
-            float thit;
-            ProceduralPrimitiveAttributes attr;
-            if (IntersectCandidateProceduralPrimitive(q, thit, attr))
-            {
-                q.CommitProceduralPrimitiveHit(thit);
-            }
-        }
-    }
-    return q.CommittedStatus() != COMMITTED_NOTHING;
+    return TraceAnyHitInline(origin, direction, AO_RADIUS);
 }
 
 [numthreads(8, 8, 1)]

@@ -69,20 +69,15 @@ bool IntersectCandidateProceduralPrimitive(RayQuery<QueryFlags> q, out float thi
     return hit;
 }
 
-// TraceShadowRayAndReportIfHit, traced inline.
-bool TraceShadowRayInlineAndReportIfHit(in Ray ray, in UINT currentRayRecursionDepth)
+// True when the ray from origin along direction meets a surface in [0, tMax]: the query of the shadow rays, which the
+// occlusion rays of InlineAmbientOcclusion.hlsl trace too.
+bool TraceAnyHitInline(float3 origin, float3 direction, float tMax)
 {
-    if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH)
-    {
-        return false;
-    }
-
-    // Set the ray's extents: TMax 10000, as the TraceRay version.
     RayDesc rayDesc;
-    rayDesc.Origin = ray.origin;
-    rayDesc.Direction = ray.direction;
+    rayDesc.Origin = origin;
+    rayDesc.Direction = direction;
     rayDesc.TMin = 0;
-    rayDesc.TMax = 10000;
+    rayDesc.TMax = tMax;
 
     // The TraceRay version's flags less SKIP_CLOSEST_HIT_SHADER, which a RayQuery may not carry (RQ-4): nothing
     // runs on a hit anyway.
@@ -102,6 +97,16 @@ bool TraceShadowRayInlineAndReportIfHit(in Ray ray, in UINT currentRayRecursionD
         }
     }
     return q.CommittedStatus() != COMMITTED_NOTHING;
+}
+
+// TraceShadowRayAndReportIfHit, traced inline: TMax 10000, as the TraceRay version.
+bool TraceShadowRayInlineAndReportIfHit(in Ray ray, in UINT currentRayRecursionDepth)
+{
+    if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH)
+    {
+        return false;
+    }
+    return TraceAnyHitInline(ray.origin, ray.direction, 10000);
 }
 
 // MyClosestHitShader_Triangle with TraceShadowRayInlineAndReportIfHit; the rest of the body is the sample's.

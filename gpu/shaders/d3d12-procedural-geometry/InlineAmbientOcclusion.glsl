@@ -126,32 +126,11 @@ bool TracePrimaryInline(vec3 origin, vec3 direction, out vec3 hitPosition, out v
     return true;
 }
 
-// True when the occlusion ray finds any surface within AO_RADIUS.
+// True when the occlusion ray finds any surface within AO_RADIUS: the shadow rays' query (InlineShadows.glsl). The
+// lesson variants' defines never reach this file's exports, so its flags are the HLSL's.
 bool TraceOcclusionInline(vec3 origin, vec3 direction)
 {
-    RayDesc rayDesc;
-    rayDesc.Origin = origin;
-    rayDesc.Direction = direction;
-    rayDesc.TMin = 0;
-    rayDesc.TMax = AO_RADIUS;
-
-    rayQueryEXT q;
-    RayQueryState qs = RayQuery_TraceRayInline(q, g_scene,
-        RAY_FLAG_CULL_BACK_FACING_TRIANGLES | RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH,
-        RAY_FLAG_NONE, TraceRayParameters_InstanceMask, rayDesc);
-    while (RayQuery_Proceed(q, qs))
-    {
-        if (RayQuery_CandidateType(q) == CANDIDATE_PROCEDURAL_PRIMITIVE)
-        {
-            float thit;
-            ProceduralPrimitiveAttributes attr;
-            if (IntersectCandidateProceduralPrimitive(q, qs, thit, attr))
-            {
-                RayQuery_CommitProceduralPrimitiveHit(q, thit);
-            }
-        }
-    }
-    return RayQuery_CommittedStatus(q) != COMMITTED_NOTHING;
+    return TraceAnyHitInline(origin, direction, AO_RADIUS);
 }
 
 #endif // INLINEAMBIENTOCCLUSION_GLSL

@@ -102,20 +102,15 @@ bool IntersectCandidateProceduralPrimitive(rayQueryEXT q, RayQueryState qs, out 
 #define INLINE_SHADOW_QUERY_FLAGS (RAY_FLAG_CULL_BACK_FACING_TRIANGLES | RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH)
 #endif
 
-// TraceShadowRayAndReportIfHit, traced inline.
-bool TraceShadowRayInlineAndReportIfHit(in Ray ray, in uint currentRayRecursionDepth)
+// True when the ray from origin along direction meets a surface in [0, tMax]: the query of the shadow rays, which the
+// occlusion rays of InlineAmbientOcclusion.glsl trace too.
+bool TraceAnyHitInline(vec3 origin, vec3 direction, float tMax)
 {
-    if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH)
-    {
-        return false;
-    }
-
-    // Set the ray's extents: TMax 10000, as the TraceRay version.
     RayDesc rayDesc;
-    rayDesc.Origin = ray.origin;
-    rayDesc.Direction = ray.direction;
+    rayDesc.Origin = origin;
+    rayDesc.Direction = direction;
     rayDesc.TMin = 0;
-    rayDesc.TMax = 10000;
+    rayDesc.TMax = tMax;
 
     // The TraceRay version's flags less SKIP_CLOSEST_HIT_SHADER, which a RayQuery may not carry (RQ-4): nothing
     // runs on a hit anyway.
@@ -142,6 +137,16 @@ bool TraceShadowRayInlineAndReportIfHit(in Ray ray, in uint currentRayRecursionD
 #endif
     }
     return RayQuery_CommittedStatus(q) != COMMITTED_NOTHING;
+}
+
+// TraceShadowRayAndReportIfHit, traced inline: TMax 10000, as the TraceRay version.
+bool TraceShadowRayInlineAndReportIfHit(in Ray ray, in uint currentRayRecursionDepth)
+{
+    if (currentRayRecursionDepth >= MAX_RAY_RECURSION_DEPTH)
+    {
+        return false;
+    }
+    return TraceAnyHitInline(ray.origin, ray.direction, 10000.0);
 }
 
 #endif // INLINESHADOWS_GLSL
