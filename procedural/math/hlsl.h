@@ -290,3 +290,6 @@ private:
 };
 
 }  // namespace refray::procedural::hlsl
+
+// The lane types (Lanes<S, N>, the shader math over a wave's rays) specialise ScalarOps and the branching intrinsics.
+#include "procedural/math/lanes.h"
