@@ -2,12 +2,17 @@
 // Proceduray: Mandelbulb and quaternion-Julia estimators and marches, the Pac-man SDF (from
 // SignedDistancePrimitives.hlsli) and its mouth animation (ProceduralPrimitivesLibrary.hlsli).
 // D3D12 sample: sdFractalPyramid and its GetDistanceFromSignedDistancePrimitive switch.
+// Every function here but MandelbulbIterationCount and PacmanMouthInterpolant (per primitive, not per ray) also runs
+// with T = Lanes<float, N>, one ray per lane (lanes.h): a per-ray `if`, `break` or early `return` of the HLSL
+// becomes a lane mask and a select (PORT comments), and lane i is bit for bit the scalar result for ray i. For a
+// scalar T the masks are bools and every select picks what the HLSL's branch picks: the scalar results are unchanged.
 #pragma once
 
 #include <cstdint>
 
 #include "procedural/math/analytic.h"
 #include "procedural/math/hlsl.h"
+#include "procedural/math/lanes.h"
 #include "procedural/math/ray.h"
 #include "procedural/math/sdf.h"
 
@@ -34,21 +39,28 @@ T mdist(const vec3<T>& p, vec4<T>& resColor, int iterations = kIterations) {
     vec4<T> trap(hlsl::abs(w), m);
     T dz = T(1);
 
-    for (int i = 0; i < iterations; i++) {
+    // PORT: the lanes that have broken out keep their values (`running`, see lanes.h); the loop ends when none runs.
+    LaneMask<T> running = allLanesSet<T>();
+    for (int i = 0; i < iterations && anyLane(running); i++) {
         // The non-PERFORMANCE branch (the live one). Exponents 7 and 8 are not the literal 2, so
         // DXC lowers both pows to exp2(y*log2(x)).
-        dz = T(8) * hlsl::pow(hlsl::sqrt(m), T(7)) * dz + T(1);
+        const T dzNext = T(8) * hlsl::pow(hlsl::sqrt(m), T(7)) * dz + T(1);
 
         const T r = hlsl::length(w);
         const T b = T(8) * hlsl::acos(w.y / r);
         const T a = T(8) * hlsl::atan2(w.x, w.z);
-        w = p + hlsl::pow(r, T(8)) *
-                    vec3<T>(hlsl::sin(b) * hlsl::sin(a), hlsl::cos(b), hlsl::sin(b) * hlsl::cos(a));
+        const vec3<T> wNext = p + hlsl::pow(r, T(8)) *
+                                      vec3<T>(hlsl::sin(b) * hlsl::sin(a), hlsl::cos(b), hlsl::sin(b) * hlsl::cos(a));
 
-        trap = hlsl::min(trap, vec4<T>(hlsl::abs(w), m));
+        const vec4<T> trapNext = hlsl::min(trap, vec4<T>(hlsl::abs(wNext), m));
 
-        m = hlsl::dot(w, w);
-        if (m > T(256)) break;
+        const T mNext = hlsl::dot(wNext, wNext);
+        // PORT: all four are assigned before the break, so the lane that breaks keeps this iteration's values.
+        dz = select(running, dzNext, dz);
+        w = select(running, wNext, w);
+        trap = select(running, trapNext, trap);
+        m = select(running, mNext, m);
+        running = running && !(m > T(256));  // if (m > 256) break;
     }
 
     resColor = vec4<T>(m, trap.y, trap.z, trap.w);
@@ -93,7 +105,7 @@ struct MandelbulbParams {
 
 template <typename T>
 struct MandelbulbHit {
-    bool hit = false;
+    LaneMask<T> hit = LaneMask<T>(false);
     T thit = T(0);
     vec3<T> normal{};  // local space, computed at pos
     vec4<T> color{};   // the orbit trap of the last mdist call (attr.color)
@@ -111,7 +123,10 @@ MandelbulbHit<T> MandelbulbDistance(const vec3<T>& ro, const vec3<T>& rd, int iM
     MandelbulbHit<T> result;
 
     vec2<T> dis = isphere(vec4<T>(T(0), T(0), T(0), T(1.25)), ro, rd);
-    if (dis.y < T(0)) return result;
+    // PORT: `if (dis.y < 0) return result;` for the lanes whose ray misses the sphere: they stay out of the march
+    // and keep result's initial values.
+    const LaneMask<T> inSphere = !(dis.y < T(0));
+    if (!anyLane(inSphere)) return result;
     dis.x = hlsl::max(dis.x, T(0));
     dis.y = hlsl::min(dis.y, T(1000));
 
@@ -119,21 +134,28 @@ MandelbulbHit<T> MandelbulbDistance(const vec3<T>& ro, const vec3<T>& rd, int iM
     T t = dis.x;
     vec3<T> pos(T(0));
 
-    for (int i = 0; i < iMax; i++) {
-        pos = ro + rd * t;
+    LaneMask<T> running = inSphere;
+    for (int i = 0; i < iMax && anyLane(running); i++) {
+        const vec3<T> posNext = ro + rd * t;
         const T th = params.threshold * t;
-        const T h = mdist(pos, trap, params.iterations);
-        if (t > dis.y || h < th) break;
-        t += h;
+        vec4<T> trapNext;
+        const T h = mdist(posNext, trapNext, params.iterations);
+        // PORT: pos and trap are assigned before the break (the lane that breaks keeps them), t after it.
+        pos = select(running, posNext, pos);
+        trap = select(running, trapNext, trap);
+        running = running && !(t > dis.y || h < th);  // if (t > dis.y || h < th) break;
+        t = select(running, t + h, t);                // t += h;
     }
 
-    if (t < dis.y) {
-        result.hit = true;
-        result.thit = t;
-        result.normal = calcNormal(pos, params.normalOffset, params.iterations);
-        result.color = trap;
+    // if (t < dis.y) { ... }
+    const LaneMask<T> hit = inSphere && (t < dis.y);
+    if (anyLane(hit)) {
+        result.hit = hit;
+        result.thit = select(hit, t, result.thit);
+        result.normal = select(hit, calcNormal(pos, params.normalOffset, params.iterations), result.normal);
+        result.color = select(hit, trap, result.color);
     }
-    result.pos = pos;
+    result.pos = select(inSphere, pos, result.pos);
     return result;
 }
 
@@ -178,26 +200,36 @@ vec2<T> iSphere(const vec3<T>& ro, const vec3<T>& rd, T rad) {
     const T b = hlsl::dot(ro, rd);
     const T c = hlsl::dot(ro, ro) - (rad * rad);
     T h = (b * b) - c;
-    if (h < T(0)) return vec2<T>(T(-1), T(-1));
+    // PORT: `if (h < 0) return (-1, -1);` per lane: a lane that misses takes (-1, -1) in the select below.
+    const LaneMask<T> miss = h < T(0);
+    if (allLanes(miss)) return vec2<T>(T(-1), T(-1));
     h = hlsl::sqrt(h);
-    return vec2<T>(-b - h, -b + h);
+    return select(miss, vec2<T>(T(-1), T(-1)), vec2<T>(-b - h, -b + h));
 }
 
 // Distance estimate of z -> z^3 + c over quaternions: (d, n) with n the iterations survived.
 // dz2 *= 9*|z^2|^2; z = z^3 + c; m2 = |z|^2; break if m2 > 256; n += 1.
 // d = 0.25*log(m2)*sqrt(m2/dz2). At p = 0, dz2 = 0 and d = +inf with n = 22 (H8).
+// PORT: `lanes` (not in the HLSL) leaves out the lanes whose result the caller discards (rays that stopped
+// marching), so that a point deep in the set does not keep the others iterating; their results are meaningless.
+// Scalar callers leave it at its default (set), the HLSL's loop.
 template <typename T>
-vec2<T> jdist(const vec3<T>& p, const vec4<T>& c, int iMax) {
+vec2<T> jdist(const vec3<T>& p, const vec4<T>& c, int iMax, LaneMask<T> lanes = allLanesSet<T>()) {
     vec4<T> z(p, T(0));
     T dz2 = T(1);
     T m2 = T(0);
     T n = T(0);
-    for (int i = 0; i < iMax; i++) {
-        dz2 *= T(9) * qLength2_float4(qSquare_float4(z));
-        z = qCube_float4(z) + c;
-        m2 = qLength2_float4(z);
-        if (m2 > T(256)) break;
-        n += T(1);
+    LaneMask<T> running = lanes;
+    for (int i = 0; i < iMax && anyLane(running); i++) {
+        const T dz2Next = dz2 * (T(9) * qLength2_float4(qSquare_float4(z)));  // dz2 *= 9*|z^2|^2
+        const vec4<T> zNext = qCube_float4(z) + c;
+        const T m2Next = qLength2_float4(zNext);
+        // PORT: dz2, z and m2 are assigned before the break (the lane that breaks keeps them), n after it.
+        dz2 = select(running, dz2Next, dz2);
+        z = select(running, zNext, z);
+        m2 = select(running, m2Next, m2);
+        running = running && !(m2 > T(256));  // if (m2 > 256) break;
+        n = select(running, n + T(1), n);     // n += 1;
     }
     const T d = (T(0.25) * hlsl::log(m2)) * hlsl::sqrt(m2 / dz2);
     return vec2<T>(d, n);
@@ -208,11 +240,13 @@ template <typename T>
 T calcNormalOffset() { return T(0.5773f) * kPrecis<T>; }
 
 // Tetrahedral normal with offset 0.5773*kPrecis on jdist(...).x.
-// PORT: the offset is a parameter (the normalEpsilonFactor knob).
+// PORT: the offset is a parameter (the normalEpsilonFactor knob). PORT: `lanes` as in jdist (the lanes whose normal
+// the caller uses).
 template <typename T>
 vec3<T> calcNormal(const vec3<T>& pos, const vec4<T>& c = kc<T>(), int iMax = kIterations,
-                   T offset = calcNormalOffset<T>()) {
-    return sdCalculateNormal(pos, [&c, iMax](const vec3<T>& q) { return jdist(q, c, iMax).x; }, offset);
+                   T offset = calcNormalOffset<T>(), LaneMask<T> lanes = allLanesSet<T>()) {
+    return sdCalculateNormal(pos, [&c, iMax, lanes](const vec3<T>& q) { return jdist(q, c, iMax, lanes).x; },
+                             offset);
 }
 
 // March in q-space between the cut planes y = deltaT and y = -1.1 inside the sphere of radius
@@ -228,28 +262,35 @@ vec2<T> raycast(const vec3<T>& ro, const vec3<T>& rd, const vec4<T>& c = kc<T>()
     T tmax = T(7000);
     T tmin = kPrecis<T>;
 
+    // PORT: the three `return (-2, 0)` are per lane: `ruledOut` collects the lanes that return there; they take
+    // (-2, 0) at the end and stay out of the march. Each if/else on a lane's value is a select.
+    LaneMask<T> ruledOut = LaneMask<T>(false);
+
     const T upperPlane = deltaT;
     const T tpS = (upperPlane - ro.y) / rd.y;
-    const bool isCamAboveUpper = (ro.y > upperPlane);
-    if (tpS > T(0)) {
-        if (isCamAboveUpper) tmin = hlsl::max(tmin, tpS);
-        else tmax = hlsl::min(tmax, tpS);
-    } else {
-        if (isCamAboveUpper) return vec2<T>(T(-2), T(0));
-    }
+    const LaneMask<T> isCamAboveUpper = (ro.y > upperPlane);
+    const LaneMask<T> tpSAhead = (tpS > T(0));
+    // if (tpS > 0) { if (isCamAboveUpper) tmin = max(tmin, tpS); else tmax = min(tmax, tpS); }
+    tmin = select(tpSAhead && isCamAboveUpper, hlsl::max(tmin, tpS), tmin);
+    tmax = select(tpSAhead && !isCamAboveUpper, hlsl::min(tmax, tpS), tmax);
+    // else { if (isCamAboveUpper) return (-2, 0); }
+    ruledOut = ruledOut || (!tpSAhead && isCamAboveUpper);
+    if (allLanes(ruledOut)) return vec2<T>(T(-2), T(0));
 
     const T lowerPlane = T(-1.1f);
     const T tpF = (lowerPlane - ro.y) / rd.y;
-    const bool isCamBellowLower = (ro.y < lowerPlane);
-    if (tpF > T(0)) {
-        if (isCamBellowLower) tmin = hlsl::max(tmin, tpF);
-        else tmax = hlsl::min(tmax, tpF);
-    } else {
-        if (isCamBellowLower) return vec2<T>(T(-2), T(0));
-    }
+    const LaneMask<T> isCamBellowLower = (ro.y < lowerPlane);
+    const LaneMask<T> tpFAhead = (tpF > T(0));
+    // if (tpF > 0) { if (isCamBellowLower) tmin = max(tmin, tpF); else tmax = min(tmax, tpF); }
+    tmin = select(tpFAhead && isCamBellowLower, hlsl::max(tmin, tpF), tmin);
+    tmax = select(tpFAhead && !isCamBellowLower, hlsl::min(tmax, tpF), tmax);
+    // else { if (isCamBellowLower) return (-2, 0); }
+    ruledOut = ruledOut || (!tpFAhead && isCamBellowLower);
+    if (allLanes(ruledOut)) return vec2<T>(T(-2), T(0));
 
     const vec2<T> bv = iSphere(ro, rd, T(1.2f));
-    if (bv.y < T(0)) return vec2<T>(T(-2), T(0));
+    ruledOut = ruledOut || (bv.y < T(0));  // if (bv.y < 0) return (-2, 0);
+    if (allLanes(ruledOut)) return vec2<T>(T(-2), T(0));
     tmin = hlsl::max(tmin, bv.x);
     tmax = hlsl::min(tmax, bv.y);
 
@@ -257,22 +298,25 @@ vec2<T> raycast(const vec3<T>& ro, const vec3<T>& rd, const vec4<T>& c = kc<T>()
     T t = tmin;
     T lt = T(0);
     T lh = T(0);
-    for (int i = 0; i < maxSteps; i++) {
-        res = jdist(ro + (rd * t), c, iMax);
-        if (res.x < precis) break;
-        lt = t;
-        lh = res.x;
-        t += hlsl::min(res.x, T(0.2));
-        if (t > tmax) break;
+    // PORT: res is assigned before the first break, lt, lh and t between the two: a lane that breaks keeps what the
+    // HLSL has at its break. jdist leaves out the lanes that no longer march.
+    LaneMask<T> running = !ruledOut;
+    for (int i = 0; i < maxSteps && anyLane(running); i++) {
+        res = select(running, jdist(ro + (rd * t), c, iMax, running), res);
+        running = running && !(res.x < precis);  // if (res.x < precis) break;
+        lt = select(running, t, lt);
+        lh = select(running, res.x, lh);
+        t = select(running, t + hlsl::min(res.x, T(0.2)), t);  // t += min(res.x, 0.2);
+        running = running && !(t > tmax);                      // if (t > tmax) break;
     }
-    if ((lt > T(9.9999997e-05f)) && (res.x < T(0))) {
-        t = lt - ((lh * (t - lt)) / (res.x - lh));
+    const LaneMask<T> secant = (lt > T(9.9999997e-05f)) && (res.x < T(0));
+    if (anyLane(secant)) {
+        t = select(secant, lt - ((lh * (t - lt)) / (res.x - lh)), t);
     }
-    T s = T(0);
-    if (t < tmax) s = t;
-    else s = T(-1);
+    // if (t < tmax) s = t; else s = -1;
+    const T s = select(t < tmax, t, T(-1));
     res.x = s;
-    return res;
+    return select(ruledOut, vec2<T>(T(-2), T(0)), res);
 }
 
 // The constants JuliaDistance passes to raycast and calcNormal; the defaults are the HLSL's.
@@ -288,7 +332,7 @@ struct JuliaParams {
 
 template <typename T>
 struct JuliaHit {
-    bool hit = false;
+    LaneMask<T> hit = LaneMask<T>(false);
     vec3<T> normal{};                   // q-space normal (same directions as local space)
     vec2<T> resT = vec2<T>(T(1e20f));   // (t in q-space units, n)
 };
@@ -305,12 +349,14 @@ JuliaHit<T> JuliaDistance(vec3<T> ro, const vec3<T>& rd, const JuliaParams<T>& p
     ro.y += T(-1);
 
     const vec2<T> tn = raycast(ro, rd, kc<T>(), T(0), params.iterations, params.marchSteps, params.precis);
-    const bool cond = (tn.x >= T(0));
-    if (cond) {
+    const LaneMask<T> cond = (tn.x >= T(0));
+    // PORT: `if (cond)` per lane: the lanes that miss keep result's initial values.
+    if (anyLane(cond)) {
         const vec3<T> pos = ro + (tn.x * rd);
-        result.normal = calcNormal(pos, kc<T>(), params.iterations, params.normalOffset);
-        result.resT = tn;
-        result.hit = true;
+        result.normal = select(cond, calcNormal(pos, kc<T>(), params.iterations, params.normalOffset, cond),
+                               result.normal);
+        result.resT = select(cond, tn, result.resT);
+        result.hit = cond;
     }
     return result;
 }
@@ -355,9 +401,10 @@ T PacmanMouthInterpolant(T time) {
 // black elsewhere (mouth and eyes). A NaN normal gives white (the > test is false).
 template <typename T>
 vec4<T> PacmanHitColor(const vec3<T>& hitSurfaceNormal, const vec3<T>& position) {
-    if (hlsl::abs(hlsl::abs(hlsl::dot(hitSurfaceNormal, hlsl::normalize(position))) - T(1)) > T(0.001))
-        return vec4<T>(T(0), T(0), T(0), T(1));
-    return vec4<T>(T(1), T(1), T(1), T(1));
+    // PORT: the `if (...) return black; return white;` is a select per lane.
+    const LaneMask<T> offHead =
+        hlsl::abs(hlsl::abs(hlsl::dot(hitSurfaceNormal, hlsl::normalize(position))) - T(1)) > T(0.001);
+    return select(offHead, vec4<T>(T(0), T(0), T(0), T(1)), vec4<T>(T(1), T(1), T(1), T(1)));
 }
 
 }  // namespace pacman
@@ -387,16 +434,18 @@ T sdFractalPyramid(vec3<T> position, const vec3<T>& h, T Scale = T(2), int itera
         T dist;
         T d;
         vec3<T> v;
+        // PORT: each `if (d < dist) { v = vk; dist = d; }` is a select per lane.
+        LaneMask<T> nearer;
         v = v1;
         dist = length_toPow2(position - v1);
         d = length_toPow2(position - v2);
-        if (d < dist) { v = v2; dist = d; }
+        nearer = d < dist; v = select(nearer, v2, v); dist = select(nearer, d, dist);
         d = length_toPow2(position - v3);
-        if (d < dist) { v = v3; dist = d; }
+        nearer = d < dist; v = select(nearer, v3, v); dist = select(nearer, d, dist);
         d = length_toPow2(position - v4);
-        if (d < dist) { v = v4; dist = d; }
+        nearer = d < dist; v = select(nearer, v4, v); dist = select(nearer, d, dist);
         d = length_toPow2(position - v5);
-        if (d < dist) { v = v5; dist = d; }
+        nearer = d < dist; v = select(nearer, v5, v); dist = select(nearer, d, dist);
 
         position = Scale * position - v * (Scale - T(1));
     }
