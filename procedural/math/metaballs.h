@@ -1,6 +1,9 @@
 // Ports: D3D12 sample VolumetricPrimitives.hlsli (N_METABALLS = 3, static loops, no
 // active-ball limiting): quintic potential, central-difference normal, animated keyframes,
 // bounding-sphere span and the fixed 128-sample march.
+// Every function here also runs over lanes (T = Lanes<float, N>, one ray per lane; procedural/math/lanes.h), lane i
+// bit for bit the scalar float result for ray i; InitializeAnimatedMetaballs with lanes of one time gives the same
+// blobs in every lane.
 #pragma once
 
 #include <array>
@@ -26,15 +29,19 @@ using Metaballs = std::array<Metaball<T>, N_METABALLS>;
 
 // Potential of one ball: with d = radius - |position - center| (inside the radius),
 // 6 d^5/r^5 - 15 d^4/r^4 + 10 d^3/r^3: 1 at the centre, 0 at the radius; 0 outside.
+// PORT: for lanes the `if` is taken when some ray is inside, and the rays outside select 0.
 template <typename T>
 T CalculateMetaballPotential(const vec3<T>& position, const Metaball<T>& blob, T& distance) {
     distance = hlsl::length(position - blob.center);
-    if (distance <= blob.radius) {
+    const LaneMask<T> inside = distance <= blob.radius;
+    if (anyLane(inside)) {
         T d = distance;
         d = blob.radius - d;
         const T r = blob.radius;
-        return T(6) * (d * d * d * d * d) / (r * r * r * r * r) - T(15) * (d * d * d * d) / (r * r * r * r) +
-               T(10) * (d * d * d) / (r * r * r);
+        return select(inside,
+                      T(6) * (d * d * d * d * d) / (r * r * r * r * r) - T(15) * (d * d * d * d) / (r * r * r * r) +
+                          T(10) * (d * d * d) / (r * r * r),
+                      T(0));
     }
     return T(0);
 }
@@ -88,17 +95,20 @@ Metaballs<T> InitializeAnimatedMetaballs(T elapsedTime, T cycleDuration) {
 
 // Union of the balls' solid-sphere spans (roots in front or behind), clipped to [TMin, TCurrent].
 // A ray missing every ball leaves tmin = +inf, tmax = -inf before the clip (D3D12 H8).
+// PORT: the `if` on a ball's hit is a select per ray.
 template <typename T>
 void FindIntersectingMetaballs(const Ray<T>& ray, const RayExtent<T>& extent, T& tmin, T& tmax,
                                const Metaballs<T>& blobs) {
-    tmin = std::numeric_limits<T>::infinity();
-    tmax = -std::numeric_limits<T>::infinity();
+    tmin = infinityOf<T>();
+    tmax = -infinityOf<T>();
     for (int i = 0; i < N_METABALLS; i++) {
         T _thit = T(0);
         T _tmax = T(0);
-        if (RaySolidSphereIntersectionTest(ray, extent, _thit, _tmax, blobs[i].center, blobs[i].radius)) {
-            tmin = hlsl::min(_thit, tmin);
-            tmax = hlsl::max(_tmax, tmax);
+        const LaneMask<T> hit =
+            RaySolidSphereIntersectionTest(ray, extent, _thit, _tmax, blobs[i].center, blobs[i].radius);
+        if (anyLane(hit)) {
+            tmin = select(hit, hlsl::min(_thit, tmin), tmin);
+            tmax = select(hit, hlsl::max(_tmax, tmax), tmax);
         }
     }
     tmin = hlsl::max(tmin, extent.tMin);
@@ -114,18 +124,21 @@ struct MetaballsParams {
     T normalOffset = metaballsNormalOffset<T>();  // CalculateMetaballsNormal's e
 };
 
+// PORT: hit is a LaneMask<T> and step a LaneUint<T>: bool and std::uint32_t for a scalar T, one per ray for lanes.
 template <typename T>
 struct MetaballsHit {
-    bool hit = false;
+    LaneMask<T> hit = LaneMask<T>(false);
     T thit = T(0);
     vec3<T> normal{};
-    std::uint32_t step = 0;  // 1-based index of the sample that hit
+    LaneUint<T> step = LaneUint<T>(0);  // 1-based index of the sample that hit
 };
 
 // MAX_STEPS (128) samples t = tmin + k*(tmax - tmin)/MAX_STEPS; the first sample with potential >= 0.25 whose
 // normal passes IsAValidHit is the hit (no refinement: up to one step inside the surface).
 // The step depends on TCurrent at call time (D3D12 H10); with no ball hit the samples are
 // inf/NaN and nothing is reported (H8).
+// PORT: for lanes, `running` holds the rays that have not returned; each sample is computed for all lanes and the
+// rays that are done keep their t. The loop ends when no ray runs (for a scalar T: at the `return`).
 template <typename T>
 MetaballsHit<T> RayMetaballsIntersectionTest(const Ray<T>& ray, const RayExtent<T>& extent, T elapsedTime,
                                              T cycleDuration = T(12), const MetaballsParams<T>& params = {}) {
@@ -140,8 +153,9 @@ MetaballsHit<T> RayMetaballsIntersectionTest(const Ray<T>& ray, const RayExtent<
     T t = tmin;
     const T minTStep = (tmax - tmin) / static_cast<T>(MAX_STEPS / 1);
     std::uint32_t iStep = 0;
+    LaneMask<T> running = allLanesSet<T>();
 
-    while (iStep++ < MAX_STEPS) {
+    while (iStep++ < MAX_STEPS && anyLane(running)) {
         const vec3<T> position = ray.origin + t * ray.direction;
         T sumFieldPotential = T(0);
         for (int j = 0; j < N_METABALLS; j++) {
@@ -150,17 +164,18 @@ MetaballsHit<T> RayMetaballsIntersectionTest(const Ray<T>& ray, const RayExtent<
         }
 
         const T Threshold = T(0.25);
-        if (sumFieldPotential >= Threshold) {
+        const LaneMask<T> candidate = running && sumFieldPotential >= Threshold;
+        if (anyLane(candidate)) {
             const vec3<T> normal = CalculateMetaballsNormal(position, blobs, params.normalOffset);
-            if (IsAValidHit(ray, t, normal, extent)) {
-                result.hit = true;
-                result.thit = t;
-                result.normal = normal;
-                result.step = iStep;
-                return result;
-            }
+            const LaneMask<T> accepted = candidate && IsAValidHit(ray, t, normal, extent);
+            // if (IsAValidHit(...)) { ...; return true; }
+            result.hit = result.hit || accepted;
+            result.thit = select(accepted, t, result.thit);
+            result.normal = select(accepted, normal, result.normal);
+            result.step = select(accepted, LaneUint<T>(iStep), result.step);
+            running = running && !accepted;
         }
-        t += minTStep;
+        t = select(running, t + minTStep, t);  // t += minTStep
     }
     return result;
 }

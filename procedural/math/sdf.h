@@ -1,6 +1,8 @@
 // Ports: SignedDistancePrimitives.hlsli (both samples); SDF cases of D3D12 ProceduralPrimitivesLibrary.hlsli.
 // Operators, primitives, sdCalculateNormal and RaySignedDistancePrimitiveTest, templated on T;
 // the fractal pyramid and the D3D12 switch live in fractals.h.
+// Every function here also runs over lanes (T = Lanes<float, N>, one ray per lane; procedural/math/lanes.h), lane i
+// bit for bit the scalar float result for ray i.
 #pragma once
 
 #include <cstdint>
@@ -24,8 +26,12 @@ T opI(T d1, T d2) { return hlsl::max(d1, d2); }
 
 // Repetition with the HLSL fmod intrinsic: no repetition for negative p (sign of the dividend,
 // D3D12 H14), and DXC's frac-based remainder at cell boundaries.
+// PORT: fmod component by component: hlsl.h's vector fmod is defined before the lanes' fmod (lanes.h), so for
+// T = Lanes it would reach the scalar lowering with its ?: on a lane mask. The same three remainders, in order.
 template <typename T>
-vec3<T> opRep(const vec3<T>& p, const vec3<T>& c) { return hlsl::fmod(p, c) - T(0.5) * c; }
+vec3<T> opRep(const vec3<T>& p, const vec3<T>& c) {
+    return vec3<T>(hlsl::fmod(p.x, c.x), hlsl::fmod(p.y, c.y), hlsl::fmod(p.z, c.z)) - T(0.5) * c;
+}
 
 // Polynomial smooth min (union) and smooth max (intersection).
 template <typename T>
@@ -256,13 +262,14 @@ SphereTraceParams<T> sphereTraceParams(const Accuracy& accuracy, T stepScale) {
     return params;
 }
 
+// PORT: hit is a LaneMask<T> and steps a LaneUint<T>: bool and std::uint32_t for a scalar T, one per ray for lanes.
 template <typename T>
 struct SphereTraceResult {
-    bool hit = false;
+    LaneMask<T> hit = LaneMask<T>(false);
     T thit = T(0);
     vec3<T> normal{};    // local-space normal at the hit
     vec3<T> position{};  // the sample that produced the hit
-    std::uint32_t steps = 0;  // loop iterations taken
+    LaneUint<T> steps = LaneUint<T>(0);  // loop iterations taken
 };
 
 // PORT: RayTMin()/RayTCurrent()/RayFlags() come in as `extent` (RayTCurrent cannot change inside
@@ -271,28 +278,36 @@ struct SphereTraceResult {
 // dist = sdf(o + t*d); if dist <= threshold*t, the normal is estimated and the hit is returned
 // if IsAValidHit accepts it; otherwise (also for a rejected candidate) t += stepScale*dist.
 // Negative distances step t backwards, as in the HLSL.
+// PORT: for lanes, `running` holds the rays still in the loop: the loop condition and the `return` clear a ray's
+// bit, every step is computed for all lanes and kept (select) in the running ones only, and the loop ends when no
+// ray runs (the step count is uniform). For a scalar T the mask is the loop's own control flow: the same operations
+// in the same order.
 template <typename T, class Sdf>
 SphereTraceResult<T> RaySignedDistancePrimitiveTest(const Ray<T>& ray, const RayExtent<T>& extent, Sdf&& sdf,
                                                     const SphereTraceParams<T>& params = {}) {
     SphereTraceResult<T> result;
     T t = extent.tMin;
+    LaneMask<T> running = allLanesSet<T>();
     std::uint32_t i = 0;
-    while (i++ < params.maxSteps && t <= extent.tCurrent) {
-        result.steps = i;
+    while (i++ < params.maxSteps) {
+        running = running && t <= extent.tCurrent;  // PORT: the loop's `&& t <= RayTCurrent()`, per ray
+        if (!anyLane(running)) break;
+        result.steps = select(running, LaneUint<T>(i), result.steps);
         const vec3<T> position = ray.origin + t * ray.direction;
         const T distance = sdf(position);
 
-        if (distance <= params.threshold * t) {
+        const LaneMask<T> candidate = running && distance <= params.threshold * t;
+        if (anyLane(candidate)) {
             const vec3<T> hitSurfaceNormal = sdCalculateNormal(position, sdf, params.normalOffset);
-            if (IsAValidHit(ray, t, hitSurfaceNormal, extent)) {
-                result.hit = true;
-                result.thit = t;
-                result.normal = hitSurfaceNormal;
-                result.position = position;
-                return result;
-            }
+            const LaneMask<T> accepted = candidate && IsAValidHit(ray, t, hitSurfaceNormal, extent);
+            // if (IsAValidHit(...)) { ...; return true; }
+            result.hit = result.hit || accepted;
+            result.thit = select(accepted, t, result.thit);
+            result.normal = select(accepted, hitSurfaceNormal, result.normal);
+            result.position = select(accepted, position, result.position);
+            running = running && !accepted;
         }
-        t += params.stepScale * distance;
+        t = select(running, t + params.stepScale * distance, t);  // t += stepScale * distance
     }
     return result;
 }
