@@ -166,20 +166,21 @@ void processTriangle(ThreadState& ts, RayState& rs, const Candidate& c, const Si
     if (endSearch || (rs.effectiveFlags & RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH)) rs.searchEnded = true;  // FLAG-8
 }
 
-void processProcedural(ThreadState& ts, RayState& rs, const Candidate& c, const Site& site) {
+bool prepareIntersection(ThreadState& ts, RayState& rs, const Candidate& c, const Site& site, HitInfo& box,
+                         RecordView& record, Invocation& inv) {
     if (c.key > rs.tCurrent) {  // the box no longer overlaps [TMin, TCurrent]
         if (observer(ts)) emitSkipped(ts, rs, "the box starts beyond RayTCurrent: no intersection shader call");
-        return;
+        return false;
     }
     const BuiltInstance& inst = rs.tlas->instances()[c.instanceIndex];
     const BuiltGeometry& geom = inst.blas->geometries()[c.geometryIndex];
     const bool opaque = isOpaque(geom.flags, inst.desc.Flags, rs.effectiveFlags);
     if (isOpacityCulled(rs.effectiveFlags, opaque)) {
         if (observer(ts)) emitSkipped(ts, rs, opaque ? "opaque, culled: CULL_OPAQUE (FLAG-11)" : "non-opaque, culled: CULL_NON_OPAQUE (FLAG-11)");
-        return;  // FLAG-11: before the IS
+        return false;  // FLAG-11: before the IS
     }
 
-    HitInfo box;
+    box = HitInfo();
     box.instance = &inst;
     box.instanceIndex = c.instanceIndex;
     box.geometryIndex = c.geometryIndex;
@@ -187,16 +188,20 @@ void processProcedural(ThreadState& ts, RayState& rs, const Candidate& c, const 
     box.objectRayOrigin = c.objectRayOrigin;
     box.objectRayDirection = c.objectRayDirection;
 
-    RecordView record;
-    if (!lookupHitGroupRecord(ts, site, rs, box, GeometryType::ProceduralPrimitiveAABBs, record)) return;
+    record = RecordView();
+    if (!lookupHitGroupRecord(ts, site, rs, box, GeometryType::ProceduralPrimitiveAABBs, record)) return false;
     if (!record.entry) {  // OPQ-4: a NULL hit group has no IS, so no hit
         if (observer(ts)) emitSkipped(ts, rs, "NULL hit group: no intersection shader, no hit (OPQ-4)");
-        return;
+        return false;
     }
 
-    Invocation inv = invocation(ts, ShaderStage::Intersection, record.entry->intersection, &record, rs.depth, &rs, &box);
+    inv = invocation(ts, ShaderStage::Intersection, record.entry->intersection, &record, rs.depth, &rs, &box);
     inv.candidateOpaque = opaque;
     checkGlobalSignature(ts, siteOf(inv), *record.entry);
+    return true;
+}
+
+void runIntersection(ThreadState& ts, RayState& rs, Invocation& inv) {
     try {
         invoke(ts, inv, nullptr, nullptr);
         if (inv.searchEnded) rs.searchEnded = true;  // ReportHitEnd::Return: the IS returned after it
@@ -205,5 +210,11 @@ void processProcedural(ThreadState& ts, RayState& rs, const Candidate& c, const 
     }
 }
 
+void processProcedural(ThreadState& ts, RayState& rs, const Candidate& c, const Site& site) {
+    HitInfo box;
+    RecordView record;
+    Invocation inv;
+    if (prepareIntersection(ts, rs, c, site, box, record, inv)) runIntersection(ts, rs, inv);
+}
 
 }  // namespace refray::dxr::detail

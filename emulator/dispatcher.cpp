@@ -1,6 +1,9 @@
 // DispatchRays (RGS-1..3): the checks of the desc, the ray generation record, and the launches over oneTBB tiles.
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <functional>
+#include <span>
 
 #include <tbb/blocked_range2d.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -13,6 +16,7 @@
 #include "emulator/detail/record_lookup.h"
 #include "emulator/detail/shader_invocation.h"
 #include "emulator/detail/thread_state.h"
+#include "emulator/detail/wave.h"
 #include "emulator/device.h"
 #include "emulator/limits.h"
 
@@ -22,7 +26,8 @@ namespace {
 
 using detail::DispatchState;
 using detail::ThreadState;
-using ThreadStates = tbb::enumerable_thread_specific<ThreadState>;
+using detail::Wave;
+using Waves = tbb::enumerable_thread_specific<Wave>;
 
 // Locks every table the dispatch reads for its whole duration (REC-12).
 class TableLock {
@@ -155,21 +160,48 @@ void runLaunch(ThreadState& ts, DispatchState& ds, uvec3 launch) {
     }
 }
 
+// The lanes per wave the dispatch runs: DispatchOptions::waveWidth, or one for an observed or profiled dispatch.
+int waveWidth(const DispatchOptions& options) {
+    if (options.observer || options.profileStages) return 1;
+    REFRAY_CHECK(options.waveWidth >= 1 && options.waveWidth <= uint32_t(kMaxWaveWidth),
+                 "wave width " << options.waveWidth << " is outside 1.." << kMaxWaveWidth);
+    return int(options.waveWidth);
+}
+
+// The launches of a wave: a block of the tile as square as the width allows (4x4 for 16 lanes), so that its rays
+// start close together and meet the same records.
+uvec2 waveBlock(int width) {
+    uint32_t w = 1;
+    while (w * w < uint32_t(width)) w *= 2;
+    const uint32_t h = uint32_t(width) / w;
+    return w * h == uint32_t(width) ? uvec2(w, h) : uvec2(uint32_t(width), 1u);
+}
+
 // Every launch of `region` at every depth, over oneTBB tiles of DispatchOptions::tileSize on
-// DispatchOptions::threads workers.
-void runTiles(DispatchState& ds, const LaunchRegion& region, ThreadStates& threadStates) {
+// DispatchOptions::threads workers; each tile in waves.
+void runTiles(DispatchState& ds, const LaunchRegion& region, Waves& waves) {
     const DispatchOptions& options = ds.options;
     const uint32_t tile = std::max(1u, options.tileSize);
+    const int width = waveWidth(options);
+    const uvec2 block = waveBlock(width);
+    const detail::LaunchFunction launch = [&ds](ThreadState& ts, uvec3 at) { runLaunch(ts, ds, at); };
     const int arenaThreads = options.threads ? int(options.threads) : tbb::task_arena::automatic;
     tbb::task_arena arena(arenaThreads);
     arena.execute([&] {
         tbb::parallel_for(
             tbb::blocked_range2d<uint32_t>(region.y, region.y + region.height, tile, region.x, region.x + region.width, tile),
             [&](const tbb::blocked_range2d<uint32_t>& range) {
-                ThreadState& ts = threadStates.local();
+                Wave& wave = waves.local();
+                std::array<uvec3, kMaxWaveWidth> launches;
                 for (uint32_t z = 0; z < ds.desc->Depth; ++z)
-                    for (uint32_t y = range.rows().begin(); y < range.rows().end(); ++y)
-                        for (uint32_t x = range.cols().begin(); x < range.cols().end(); ++x) runLaunch(ts, ds, uvec3(x, y, z));
+                    for (uint32_t y0 = range.rows().begin(); y0 < range.rows().end(); y0 += block.y)
+                        for (uint32_t x0 = range.cols().begin(); x0 < range.cols().end(); x0 += block.x) {
+                            size_t count = 0;
+                            for (uint32_t y = y0; y < std::min(y0 + block.y, range.rows().end()); ++y)
+                                for (uint32_t x = x0; x < std::min(x0 + block.x, range.cols().end()); ++x)
+                                    launches[count++] = uvec3(x, y, z);
+                            detail::runWave(wave, std::span<const uvec3>(launches.data(), count), launch);
+                        }
                 if (options.progress) options.progress->advance(range.rows().size() * range.cols().size());
             });
     });
@@ -187,14 +219,16 @@ DispatchStats finishedStats(const ThreadState& ts) {
 
 // Every thread's diagnostics and statistics, merged into `result`. OnError::Stop: throws the error of the
 // lowest launch index (GEN-1).
-void collectResults(ThreadStates& threadStates, const DispatchRaysDesc& desc, DispatchResult& result) {
+void collectResults(Waves& waves, const DispatchRaysDesc& desc, DispatchResult& result) {
     std::vector<Diagnostic> errors;
-    for (auto& ts : threadStates) {
+    for (Wave& wave : waves)
+        for (detail::WaveLane& lane : wave.lanes) {
+        ThreadState& ts = lane.ts;
         detail::foldNotes(ts);
         result.diagnostics.merge(ts.log);
         result.stats.merge(finishedStats(ts));
         errors.insert(errors.end(), ts.stopErrors.begin(), ts.stopErrors.end());
-    }
+        }
     if (!errors.empty()) {
         auto linear = [&](const Diagnostic& d) { return linearIndex(desc, d.site ? d.site->launchIndex : uvec3(0u)); };
         auto first = std::min_element(errors.begin(), errors.end(),
@@ -219,15 +253,9 @@ void initDispatchState(DispatchState& ds, Device* device, const GpuMemory& memor
 
 // Runs every launch of `region` on per-thread states and merges their diagnostics and statistics into `result`.
 void runLaunches(DispatchState& ds, const LaunchRegion& region, DispatchResult& result) {
-    ThreadStates threadStates([&] {
-        ThreadState ts;
-        ts.dispatch = &ds;
-        ts.candidates.reserve(64);
-        ts.profiling = ds.options.profileStages;
-        return ts;
-    });
-    runTiles(ds, region, threadStates);
-    collectResults(threadStates, *ds.desc, result);
+    Waves waves(std::ref(ds));
+    runTiles(ds, region, waves);
+    collectResults(waves, *ds.desc, result);
 }
 
 }  // namespace

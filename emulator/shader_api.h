@@ -28,6 +28,7 @@ struct ArgumentBytes;  // dispatch_state.h
 
 class ShaderContext;
 class RayQueryObject;
+class IntersectionWave;
 
 // HLSL SamplerState: a sampler resolved from an s register by ShaderContext::SamplerState. Valid for the dispatch
 // that resolved it.
@@ -229,6 +230,7 @@ public:
 
 private:
     friend class RayQueryObject;  // a query belongs to the invocation that made it (emulator/ray_query.h)
+    friend class IntersectionWave;  // reads whether a lane's ReportHit ended its search (emulator/intersection_wave.h)
 
     // Stage masks for SV-1.
     static constexpr uint8_t bit(ShaderStage s) { return detail::stageBit(s); }

@@ -40,7 +40,7 @@ void checkPayload(ThreadState& ts, const Site& site, const ShaderExport& shader,
                             .value("shader payload", shader.payload.name() + " (" + std::to_string(shader.payload.size) + " B)"));
 }
 
-void invoke(ThreadState& ts, Invocation& inv, void* payload, const void* attributes) {
+uint8_t beginInvocation(ThreadState& ts, const Invocation& inv) {
     ts.stats.invocations[size_t(inv.stage)]++;
     countInvocation(ts, inv.shader);
     if (observer(ts)) {
@@ -54,19 +54,25 @@ void invoke(ThreadState& ts, Invocation& inv, void* payload, const void* attribu
         if (inv.hit) setHit(e, *inv.hit);
         observer(ts)->onEvent(e);
     }
-    ShaderContext ctx(inv);
+    ts.callChain.push_back(inv.shader);
+    return ts.profiling ? ts.clock.enter(uint8_t(profileStageOf(inv.stage))) : StageClock::kOutside;
+}
+
+void endInvocation(ThreadState& ts, uint8_t callerSection) {
+    ts.callChain.pop_back();
+    if (ts.profiling) ts.clock.enter(callerSection);
+}
+
+void invoke(ThreadState& ts, Invocation& inv, void* payload, const void* attributes) {
     // On every exit, non-local ones included: pop the call chain and, when profiling, hand the clock back
     // to the caller's section. One object, so the IgnoreHit / end-search signals unwind one cleanup here.
     struct ShaderScope {
         ThreadState& ts;
         uint8_t callerSection;
-        ~ShaderScope() {
-            ts.callChain.pop_back();
-            if (ts.profiling) ts.clock.enter(callerSection);
-        }
+        ~ShaderScope() { endInvocation(ts, callerSection); }
     };
-    ts.callChain.push_back(inv.shader);
-    const ShaderScope scope{ts, ts.profiling ? ts.clock.enter(uint8_t(profileStageOf(inv.stage))) : StageClock::kOutside};
+    const ShaderScope scope{ts, beginInvocation(ts, inv)};
+    ShaderContext ctx(inv);
     inv.shader->function(ctx, payload, attributes);
 }
 

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "core/strings.h"
+#include "emulator/intersection_wave.h"
 #include "emulator/limits.h"
 #include "emulator/validation.h"
 
@@ -62,6 +63,15 @@ void ShaderLibrary::add(ShaderExport e) {
     REFRAY_CHECK(!exports_.count(e.name), "shader library already exports '" << e.name << "'");
     const std::string name = e.name;
     exports_.emplace(name, std::move(e));
+}
+
+void ShaderLibrary::addWaveIntersection(std::string name, TypeTag attributes, WaveIntersectionShader fn,
+                                        ReportHitEnd end) {
+    REFRAY_CHECK(fn, "shader export '" << name << "' has no function");
+    ShaderExport e{std::move(name), ShaderStage::Intersection, {}, attributes, {},
+                   [fn](ShaderContext& c, void*, const void*) { IntersectionWave::runAlone(fn, c); }, end};
+    e.waveIntersection = std::move(fn);
+    add(std::move(e));
 }
 
 const ShaderExport* ShaderLibrary::find(const std::string& name) const {

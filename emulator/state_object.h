@@ -40,6 +40,10 @@ TypeTag typeTag() {
 // were checked against the export's declared TypeTags before the call.
 using ErasedShader = std::function<void(ShaderContext&, void* payload, const void* attributes)>;
 
+// An intersection shader written for waves (emulator/intersection_wave.h): run once over the lanes of a record group.
+class IntersectionWave;
+using WaveIntersectionShader = std::function<void(IntersectionWave&)>;
+
 // How an intersection shader ends when one of its ReportHit calls ends the search (IS-10: FLAG-8, or an any-hit
 // shader's AcceptHitAndEndSearch). docs/emulator.md, "Ending an intersection shader".
 enum class ReportHitEnd : uint8_t {
@@ -65,6 +69,8 @@ struct ShaderExport {
     // The RayQuery objects the shader's code declares (RQ-2), by their template ray flags, in source order: what
     // DXIL records and `refray table` shows. A shader that makes a RayQuery it does not declare stops with RQ-2.
     std::vector<uint32_t> rayQueryFlags = {};
+    // IS written for waves: the wave's record groups call this; `function` runs it for one lane alone.
+    WaveIntersectionShader waveIntersection = {};
 };
 
 // A DXIL library: named shader exports. Signatures mirror HLSL entry points:
@@ -81,6 +87,12 @@ public:
                          ReportHitEnd end = ReportHitEnd::Unwind) {
         add({std::move(name), ShaderStage::Intersection, {}, typeTag<Attributes>(), {},
              [fn = std::move(fn)](ShaderContext& c, void*, const void*) { fn(c); }, end});
+    }
+    // An intersection shader written for waves (emulator/intersection_wave.h): one call computes the lanes of a record
+    // group together; each lane's ReportHit goes through IntersectionWave::ReportHit.
+    template <class Attributes>
+    void addWaveIntersection(std::string name, WaveIntersectionShader fn, ReportHitEnd end = ReportHitEnd::Unwind) {
+        addWaveIntersection(std::move(name), typeTag<Attributes>(), std::move(fn), end);
     }
     template <class Payload, class Attributes>
     void addAnyHit(std::string name, std::function<void(ShaderContext&, Payload&, const Attributes&)> fn) {
@@ -115,6 +127,7 @@ public:
 
 private:
     void add(ShaderExport e);
+    void addWaveIntersection(std::string name, TypeTag attributes, WaveIntersectionShader fn, ReportHitEnd end);
     std::map<std::string, ShaderExport> exports_;
 };
 

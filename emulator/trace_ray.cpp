@@ -4,12 +4,11 @@
 
 #include <cmath>
 
-#include "emulator/detail/candidate_gathering.h"
-#include "emulator/detail/candidate_processing.h"
 #include "emulator/detail/record_lookup.h"
 #include "emulator/detail/shader_invocation.h"
 #include "emulator/detail/thread_state.h"
 #include "emulator/detail/trace_events.h"
+#include "emulator/detail/wave.h"
 #include "emulator/device.h"
 #include "emulator/limits.h"
 
@@ -195,24 +194,6 @@ bool checkBottomLevelsCurrent(ThreadState& ts, const Site& site, const TopLevelA
     return true;
 }
 
-// TRV-4: the ray's candidates in order (gathered by gatherOrderedCandidates), each meeting the DXR rules, until
-// the search ends.
-void processCandidates(ThreadState& ts, RayState& rs, const Site& site) {
-    // Nested TraceRays (from the CHS that follows) reuse ts.candidates: iterate over a copy only
-    // while shaders of this ray may run, which ends before the CHS starts.
-    for (size_t i = 0; i < ts.candidates.size() && !rs.searchEnded; ++i) {
-        const Candidate c = ts.candidates[i];
-        if (observer(ts)) {
-            TraceEvent e = event(ts, TraceEvent::Kind::Candidate, rs.depth);
-            setHit(e, rs.tlas->instances()[c.instanceIndex], c.instanceIndex, c.geometryIndex, c.primitiveIndex);
-            e.procedural = c.procedural;
-            e.t = c.procedural ? c.key : c.t;
-            observer(ts)->onEvent(e);
-        }
-        processCandidate(ts, rs, c, site);
-    }
-}
-
 // TRV-5, TRV-6: at most one CHS or one miss shader.
 void runClosestHitOrMiss(ThreadState& ts, RayState& rs, const Site& site) {
     const DispatchState& ds = *ts.dispatch;
@@ -308,8 +289,7 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
     if (asAddress != 0 && traceable) {
         rs.tlas = findTopLevelAS(ts, site, asAddress);
         if (!rs.tlas) return;
-        gatherOrderedCandidates(ts, rs, site);
-        processCandidates(ts, rs, site);
+        awaitTraversal(ts, rs, site);  // the wave's packet gathers and processes the candidates (detail/wave.h)
     }
     runClosestHitOrMiss(ts, rs, site);
     if (observer(ts)) emitRay(ts, rs, TraceEvent::Kind::TraceRayEnd, asAddress, mask);

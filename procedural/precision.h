@@ -30,5 +30,10 @@ template <>
 struct PrecisionScope<float> {
     hlsl::ScopedFlushDenormals ftz;
 };
+// A wave's float lanes (procedural/math/lanes.h) flush as float does.
+template <int N>
+struct PrecisionScope<math::Lanes<float, N>> {
+    hlsl::ScopedFlushDenormals ftz;
+};
 
 }  // namespace refray::procedural

@@ -63,6 +63,8 @@ struct RenderSettings {
     bool profileStages = false;
     // DispatchOptions::specialise: traversal shortcuts that change no result.
     bool specialise = true;
+    // DispatchOptions::waveWidth: lanes per wave (1..16); the image is the same for every width.
+    uint32_t waveWidth = 16;
     // Empty: the emulator runs the dispatch (dxr::Device::dispatchRays).
     DispatchBackend backend;
     // The same for a compute dispatch (dxr::Device::dispatch). A render with `backend` set and this empty refuses
@@ -82,6 +84,7 @@ inline dxr::DispatchOptions dispatchOptions(const RenderSettings& settings, uint
     options.observer = settings.observer;
     options.profileStages = settings.profileStages;
     options.specialise = settings.specialise;
+    options.waveWidth = settings.waveWidth;
     if (settings.progress) {
         if (settings.region) launches = uint64_t(settings.region->width) * settings.region->height;
         progress = std::make_unique<Progress>("render", launches, settings.progress);

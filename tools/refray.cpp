@@ -184,6 +184,7 @@ struct RenderOptions {
     bool stats = false;
     std::string statsJson;  // --stats-json FILE
     bool noShortcuts = false;  // --no-shortcuts: DispatchOptions::specialise off
+    uint32_t waveWidth = 16;   // --wave-width: DispatchOptions::waveWidth
     bool noStageTimes = false;  // --no-stage-times: --stats without DispatchOptions::profileStages
     std::string order = "ordered";
     uint64_t seed = 0;  // RenderSettings::seed (the first batch's) and the adversarial order's seed
@@ -330,6 +331,7 @@ int runRender(const RenderOptions& o) {
     for (const std::string& k : o.knobs) scenes::applyKnobAssignment(settings, k);
     settings.profileStages = (o.stats || !o.statsJson.empty()) && !o.noStageTimes;
     settings.specialise = !o.noShortcuts;
+    settings.waveWidth = o.waveWidth;
 
     REFRAY_CHECK(o.device != "vulkan" || o.orderCheck == 0,
                  "--device vulkan renders in the GPU's own traversal order; --order-check needs the emulator's orders");
@@ -492,6 +494,11 @@ int main(int argc, char** argv) {
     render->add_flag("--no-shortcuts", ro.noShortcuts,
                      "Gather every candidate of every ray and unwind every intersection shader whose ReportHit ends "
                      "the search: no shortcuts (for measuring them; the image is the same)");
+    render->add_option("--wave-width", ro.waveWidth,
+                       "Lanes per wave of the emulator (docs/emulator.md, \"Waves\"): launches run together, their rays "
+                       "traverse as a packet and their intersection shaders run once per record over the lanes that "
+                       "reach it. The image is the same for every width (default 16)")
+        ->check(CLI::Range(1, 16));
     render->add_option("--aov", ro.aov,
                        "Write an index map instead of the render: record|instance|geometry|primitive|hitgroup|depth "
                        "of each pixel's primary ray, false-coloured, with a legend (-o FILE.exr: the values "

@@ -20,6 +20,12 @@ void processTriangle(ThreadState& ts, RayState& rs, const Candidate& c, const Si
 // TRV-4 for an AABB candidate: FLAG-11, then the intersection shader, whose ReportHit commits (OPQ-4: none for a
 // NULL hit group).
 void processProcedural(ThreadState& ts, RayState& rs, const Candidate& c, const Site& site);
+// processProcedural in two steps, for the wave's record groups (emulator/detail/wave.h): the checks before the
+// intersection shader (the interval, FLAG-11, the record, OPQ-4, PIPE-6), which fill `box`, `record` and `inv` (which
+// points at them) and return whether the shader runs; then the call on its own.
+bool prepareIntersection(ThreadState& ts, RayState& rs, const Candidate& c, const Site& site, HitInfo& box,
+                         RecordView& record, Invocation& inv);
+void runIntersection(ThreadState& ts, RayState& rs, Invocation& inv);
 
 // TRV-4 for `c`, the ray's next candidate: skips it or runs its intersection or any-hit shader, and commits what
 // they accept. Sets rs.searchEnded when the search has ended (FLAG-8, AHS-4, IS-10).

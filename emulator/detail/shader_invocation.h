@@ -58,6 +58,11 @@ void checkPayload(ThreadState& ts, const Site& site, const ShaderExport& shader,
 // Runs `inv`'s shader with `payload` and `attributes`, counting the invocation and, when observed, emitting a
 // ShaderCall event. Non-local exits (IgnoreHit, end of search) propagate to the caller.
 void invoke(ThreadState& ts, Invocation& inv, void* payload, const void* attributes);
+// invoke's bookkeeping around a shader call that runs elsewhere (a wave's intersection shader, for each of its
+// lanes): beginInvocation counts and reports the call and enters its stage; endInvocation leaves it with what
+// beginInvocation returned.
+uint8_t beginInvocation(ThreadState& ts, const Invocation& inv);
+void endInvocation(ThreadState& ts, uint8_t callerSection);
 
 // CallShader (CALL-1, CALL-3) from the shader `caller`: the callable record at `shaderIndex`, run with a copy of
 // `parameters` that is copied back. A NULL record returns with the parameters unchanged (REC-8).

@@ -50,8 +50,11 @@ struct NoteTally {
     Diagnostic first;
 };
 
+struct WaveLane;
+
 struct ThreadState {
     DispatchState* dispatch = nullptr;
+    WaveLane* lane = nullptr;  // the wave lane this state belongs to (detail/wave.h); null for a probe
     uvec3 launchIndex{0u};
     uint64_t linearIndex = 0;
     DiagnosticLog log;

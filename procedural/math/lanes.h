@@ -12,6 +12,7 @@
 // the running ones only (select), and stops when no lane runs; for a scalar T that is the original loop and break.
 #pragma once
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <type_traits>
@@ -236,18 +237,76 @@ struct ScalarOps<math::Lanes<S, N>> {
         for (int i = 0; i < N; ++i) r.v[i] = f(a.v[i], b.v[i]);
         return r;
     }
-    static L abs(const L& x) { return map(x, [](S a) { return ScalarOps<S>::abs(a); }); }
-    static L floor(const L& x) { return map(x, [](S a) { return ScalarOps<S>::floor(a); }); }
-    static L sqrt(const L& x) { return map(x, [](S a) { return ScalarOps<S>::sqrt(a); }); }
-    static L rsqrt(const L& x) { return map(x, [](S a) { return ScalarOps<S>::rsqrt(a); }); }
+    static constexpr bool kFloat = std::is_same_v<S, float>;
+    // float lanes: the instructions a compiler can vectorise, each bit for bit libm's (glibc's fabsf, floorf, sqrtf,
+    // fminf and fmaxf; the lanes test checks them on special values), so that the wave math runs in SIMD registers.
+    static L abs(const L& x) {
+        if constexpr (kFloat) {
+            L r;
+            for (int i = 0; i < N; ++i) r.v[i] = std::bit_cast<float>(std::bit_cast<uint32_t>(x.v[i]) & 0x7fffffffu);
+            return r;
+        } else {
+            return map(x, [](S a) { return ScalarOps<S>::abs(a); });
+        }
+    }
+    static L floor(const L& x) {
+        if constexpr (kFloat) {
+            // Below 2^23 in magnitude: truncate, step down where that rounded up, keep the sign (floor(-0) = -0);
+            // from 2^23 on (and NaN, infinity) every float is its own floor.
+            L r;
+            for (int i = 0; i < N; ++i) {
+                const float a = x.v[i];
+                float t = float(int32_t(std::bit_cast<float>(std::bit_cast<uint32_t>(a) & 0x7fffffffu) < 0x1p23f ? a : 0.0f));
+                t = t > a ? t - 1.0f : t;
+                t = std::bit_cast<float>((std::bit_cast<uint32_t>(t) & 0x7fffffffu) | (std::bit_cast<uint32_t>(a) & 0x80000000u));
+                r.v[i] = std::bit_cast<float>(std::bit_cast<uint32_t>(a) & 0x7fffffffu) < 0x1p23f ? t : a;
+            }
+            return r;
+        } else {
+            return map(x, [](S a) { return ScalarOps<S>::floor(a); });
+        }
+    }
+    static L sqrt(const L& x) {
+#if REFRAY_HAS_MXCSR
+        if constexpr (kFloat && N % 4 == 0) {
+            L r;
+            for (int i = 0; i < N; i += 4) _mm_storeu_ps(r.v + i, _mm_sqrt_ps(_mm_loadu_ps(x.v + i)));
+            return r;
+        }
+#endif
+        return map(x, [](S a) { return ScalarOps<S>::sqrt(a); });
+    }
+    static L rsqrt(const L& x) {
+        if constexpr (kFloat) return L(1.0f) / sqrt(x);
+        else return map(x, [](S a) { return ScalarOps<S>::rsqrt(a); });
+    }
     static L sin(const L& x) { return map(x, [](S a) { return ScalarOps<S>::sin(a); }); }
     static L cos(const L& x) { return map(x, [](S a) { return ScalarOps<S>::cos(a); }); }
     static L acos(const L& x) { return map(x, [](S a) { return ScalarOps<S>::acos(a); }); }
     static L atan(const L& x) { return map(x, [](S a) { return ScalarOps<S>::atan(a); }); }
     static L exp2(const L& x) { return map(x, [](S a) { return ScalarOps<S>::exp2(a); }); }
     static L log2(const L& x) { return map(x, [](S a) { return ScalarOps<S>::log2(a); }); }
-    static L min(const L& a, const L& b) { return map(a, b, [](S x, S y) { return ScalarOps<S>::min(x, y); }); }
-    static L max(const L& a, const L& b) { return map(a, b, [](S x, S y) { return ScalarOps<S>::max(x, y); }); }
+    // glibc's fminf/fmaxf: the first operand when the two compare equal (so min(+0, -0) = +0), the other operand
+    // when one is a quiet NaN, the second when both are. (Signalling NaNs, which no arithmetic makes, are not
+    // quietened as libm does.)
+    static L min(const L& a, const L& b) {
+        if constexpr (kFloat) {
+            L r;
+            for (int i = 0; i < N; ++i) r.v[i] = (a.v[i] <= b.v[i] || (b.v[i] != b.v[i] && a.v[i] == a.v[i])) ? a.v[i] : b.v[i];
+            return r;
+        } else {
+            return map(a, b, [](S x, S y) { return ScalarOps<S>::min(x, y); });
+        }
+    }
+    static L max(const L& a, const L& b) {
+        if constexpr (kFloat) {
+            L r;
+            for (int i = 0; i < N; ++i) r.v[i] = (a.v[i] >= b.v[i] || (b.v[i] != b.v[i] && a.v[i] == a.v[i])) ? a.v[i] : b.v[i];
+            return r;
+        } else {
+            return map(a, b, [](S x, S y) { return ScalarOps<S>::max(x, y); });
+        }
+    }
     static L frem(const L& a, const L& b) { return map(a, b, [](S x, S y) { return ScalarOps<S>::frem(x, y); }); }
     // The scalar type's dot, lane by lane (its order of terms and its rounding).
     template <glm::length_t K, glm::qualifier Q>
@@ -281,3 +340,10 @@ math::Lanes<S, N> fmod(math::Lanes<S, N> x, math::Lanes<S, N> y) {
 }
 
 }  // namespace refray::procedural::hlsl
+
+namespace refray::procedural::math {
+// hlsl.h's vector forms call these unqualified (for lanes, argument-dependent lookup searches this namespace).
+using hlsl::atan2;
+using hlsl::fmod;
+using hlsl::step;
+}  // namespace refray::procedural::math

@@ -26,6 +26,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "core/fiber_local.h"
 #include "procedural/math/hlsl.h"
 #include "procedural/perturbation.h"
 #include "procedural/precision.h"
@@ -86,6 +87,11 @@ private:
 // The context of the perturbed shader call running on this thread (perturbed::Scope); null outside one.
 inline constinit thread_local const Context* tCurrentContext = nullptr;
 inline const Context* current() { return tCurrentContext; }
+// The context belongs to the shader call that installed it, so it follows that call's fiber when the wave executor
+// switches lanes on a thread (core/fiber_local.h).
+inline const bool kContextFollowsFibers = registerFiberLocal(
+    {[]() -> void* { return const_cast<Context*>(tCurrentContext); },
+     [](void* context) { tCurrentContext = static_cast<const Context*>(context); }});
 
 inline uint64_t bits(float x) { return std::bit_cast<uint32_t>(x); }
 inline uint64_t bits(float a, float b) { return bits(a) | bits(b) << 32; }

@@ -1,0 +1,68 @@
+// The wave executor (docs/emulator.md, "Waves"): each worker thread runs its launches in waves of up to
+// kMaxWaveWidth lanes. A lane is one launch: its ray generation (or compute) shader and everything that shader calls
+// run on the lane's own fiber (emulator/fiber.h) with the lane's own ThreadState. A TraceRay parks its lane
+// (awaitTraversal); when every lane of the wave is parked or done, the rays of the parked lanes traverse together as
+// a packet (packet_traversal.cpp), whose intersection shaders run once per record for the lanes that reached it
+// (record grouping); then each lane resumes with its ray's closest-hit or miss shader. Internal to the emulator.
+#pragma once
+
+#include <array>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <span>
+
+#include "emulator/detail/dispatch_errors.h"
+#include "emulator/detail/invocation.h"
+#include "emulator/detail/thread_state.h"
+#include "emulator/fiber.h"
+#include "emulator/lane_mask.h"
+
+namespace refray::dxr::detail {
+
+struct Wave;
+
+// One lane: the launch it runs, and the TraceRay it waits on.
+struct WaveLane {
+    ThreadState ts;
+    Wave* wave = nullptr;
+    int index = 0;
+    // The parked TraceRay: its ray and where it was called. Set by awaitTraversal, read by the packet.
+    RayState* ray = nullptr;
+    Site site{ShaderStage::RayGeneration, &kNoExport, 0};
+    // An exception the packet raised for this lane (an error that stops its launch): rethrown on its fiber.
+    std::exception_ptr failure;
+    // The packet's place in the ray's candidates, and the intersection-shader call the lane waits for in a
+    // record group (the invocation points at `box` and `record`).
+    size_t nextCandidate = 0;
+    HitInfo box;
+    RecordView record;
+    Invocation intersection;
+};
+
+// A worker thread's wave: its lanes and their fibers, kept from wave to wave.
+struct Wave {
+    explicit Wave(DispatchState& ds);
+    Wave(const Wave&) = delete;
+    Wave& operator=(const Wave&) = delete;
+
+    std::array<WaveLane, kMaxWaveWidth> lanes;
+    std::array<std::unique_ptr<Fiber>, kMaxWaveWidth> fibers;
+    LaneMask parked;  // lanes whose TraceRay waits for the packet
+};
+
+// Runs one launch on a lane's ThreadState (the dispatcher's launch: the ray generation or compute shader).
+using LaunchFunction = std::function<void(ThreadState&, uvec3)>;
+
+// Runs `launches` (at most kMaxWaveWidth) as the lanes of `wave`, until every lane is done.
+void runWave(Wave& wave, std::span<const uvec3> launches, const LaunchFunction& launch);
+
+// TraceRay's traversal for `rs` (TRV-4: its candidates gathered, ordered and processed), which the caller's wave
+// runs in a packet with the other lanes' rays; returns when the ray's search is over. Rethrows what stopped the
+// lane's launch meanwhile.
+void awaitTraversal(ThreadState& ts, RayState& rs, const Site& site);
+
+// packet_traversal.cpp: the traversal of the rays of `lanes` (parked TraceRays).
+void traversePacket(Wave& wave, LaneMask lanes);
+
+}  // namespace refray::dxr::detail

@@ -1,0 +1,113 @@
+// Packet traversal (docs/emulator.md, "Waves"): the parked TraceRays of a wave traverse together. Each ray gathers
+// and orders its candidates exactly as alone (GEN-3), then the packet walks the rays' candidates in rounds: a lane
+// handles its candidates in its ray's order until it reaches one whose intersection shader is written for waves;
+// there it waits, grouped with the other lanes waiting on the same record (record_grouping.h), and each group's
+// shader runs once over its lanes. A lane's candidates, shader calls, commits and diagnostics are those of the ray
+// traced alone: lanes share nothing but the shader call.
+#include <array>
+#include <optional>
+
+#include "emulator/detail/candidate_gathering.h"
+#include "emulator/detail/candidate_processing.h"
+#include "emulator/detail/record_grouping.h"
+#include "emulator/detail/shader_invocation.h"
+#include "emulator/detail/trace_events.h"
+#include "emulator/detail/wave.h"
+#include "emulator/intersection_wave.h"
+
+namespace refray::dxr::detail {
+
+namespace {
+
+void emitCandidate(const ThreadState& ts, const RayState& rs, const Candidate& c) {
+    TraceEvent e = event(ts, TraceEvent::Kind::Candidate, rs.depth);
+    setHit(e, rs.tlas->instances()[c.instanceIndex], c.instanceIndex, c.geometryIndex, c.primitiveIndex);
+    e.procedural = c.procedural;
+    e.t = c.procedural ? c.key : c.t;
+    observer(ts)->onEvent(e);
+}
+
+// TRV-4 for the lane's next candidates, in order, until its search ends, its candidates run out (true: the lane is
+// done) or it reaches an intersection shader written for waves (false: lane.intersection is prepared).
+bool advanceLane(WaveLane& lane) {
+    ThreadState& ts = lane.ts;
+    RayState& rs = *lane.ray;
+    // Nested TraceRays (from the CHS that follows) reuse ts.candidates: they start only after this ray's search.
+    while (lane.nextCandidate < ts.candidates.size() && !rs.searchEnded) {
+        const Candidate c = ts.candidates[lane.nextCandidate++];
+        if (observer(ts)) emitCandidate(ts, rs, c);
+        if (!c.procedural) {
+            processTriangle(ts, rs, c, lane.site);
+            continue;
+        }
+        if (!prepareIntersection(ts, rs, c, lane.site, lane.box, lane.record, lane.intersection)) continue;
+        if (lane.intersection.shader->waveIntersection) return false;
+        runIntersection(ts, rs, lane.intersection);
+    }
+    return true;
+}
+
+// One record group's intersection shader, run once over its lanes.
+void runIntersectionGroup(Wave& wave, LaneMask group) {
+    const ShaderExport& shader = *wave.lanes[size_t(group.lowest())].intersection.shader;
+    std::array<std::optional<ShaderContext>, kMaxWaveWidth> contexts;
+    std::array<ShaderContext*, kMaxWaveWidth> lanes{};
+    std::array<uint8_t, kMaxWaveWidth> callerSections{};
+    for (int i : group) {
+        WaveLane& lane = wave.lanes[size_t(i)];
+        callerSections[size_t(i)] = beginInvocation(lane.ts, lane.intersection);
+        lanes[size_t(i)] = &contexts[size_t(i)].emplace(lane.intersection);
+    }
+    IntersectionWave shaderWave(lanes, group);
+    std::exception_ptr escaped;
+    try {
+        shader.waveIntersection(shaderWave);
+    } catch (...) {
+        escaped = std::current_exception();  // not one lane's: it stops every lane still running the shader
+    }
+    for (int i : group) {
+        WaveLane& lane = wave.lanes[size_t(i)];
+        endInvocation(lane.ts, callerSections[size_t(i)]);
+        if (shaderWave.failure(i)) lane.failure = shaderWave.failure(i);
+        else if (escaped && shaderWave.isActive(i)) lane.failure = escaped;
+        else if (lane.intersection.searchEnded || shaderWave.endedByUnwinding(i)) lane.ray->searchEnded = true;
+    }
+}
+
+}  // namespace
+
+void traversePacket(Wave& wave, LaneMask lanes) {
+    LaneMask running;
+    for (int i : lanes) {
+        WaveLane& lane = wave.lanes[size_t(i)];
+        try {
+            gatherOrderedCandidates(lane.ts, *lane.ray, lane.site);
+            lane.nextCandidate = 0;
+            running.set(i);
+        } catch (...) {
+            lane.failure = std::current_exception();
+        }
+    }
+    RecordGroups groups;
+    while (running.any()) {
+        groups.clear();
+        for (int i : running) {
+            WaveLane& lane = wave.lanes[size_t(i)];
+            bool done = true;
+            try {
+                done = advanceLane(lane);
+            } catch (...) {
+                lane.failure = std::current_exception();
+            }
+            if (done) running.clear(i);
+            else groups.add(i, lane.intersection.shader, lane.record.address);
+        }
+        for (const RecordGroups::Group& group : groups) {
+            runIntersectionGroup(wave, group.lanes);
+            for (int i : group.lanes)
+                if (wave.lanes[size_t(i)].failure) running.clear(i);
+        }
+    }
+}
+
+}  // namespace refray::dxr::detail
