@@ -30,3 +30,21 @@ if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
   target_compile_options(refray_compiler_workarounds INTERFACE -fno-tree-slp-vectorize)
 endif()
 target_link_libraries(refray_warnings INTERFACE refray_sanitizers refray_compiler_workarounds)
+
+# The wave executor's lane math (procedural/math/lanes.h) keeps 16 float lanes in SIMD registers only where the
+# target has wide vectors: refray is compiled for the machine that builds it (tools/setup.sh builds from source
+# where it runs), as lavapipe compiles its shaders for the CPU it runs on. Floating-point contraction stays off, so
+# that no multiply and add fuse into an FMA the scalar code does not have: every result is the same as without
+# -march (tests/stability). -Wno-psabi: GCC notes that passing wide vectors changed ABI in GCC 4.x, which is
+# nothing refray crosses. REFRAY_NATIVE_ARCH=OFF builds for any x86-64 (tools/gpu_bundle.sh, for another machine).
+option(REFRAY_NATIVE_ARCH "Compile for the building machine's CPU (-march=native)" ON)
+add_library(refray_target_cpu INTERFACE)
+target_compile_options(refray_target_cpu INTERFACE -ffp-contract=off -Wno-psabi)
+if(REFRAY_NATIVE_ARCH)
+  include(CheckCXXCompilerFlag)
+  check_cxx_compiler_flag(-march=native REFRAY_HAVE_MARCH_NATIVE)
+  if(REFRAY_HAVE_MARCH_NATIVE)
+    target_compile_options(refray_target_cpu INTERFACE -march=native)
+  endif()
+endif()
+target_link_libraries(refray_warnings INTERFACE refray_target_cpu)

@@ -43,12 +43,14 @@ bool processNow(void* user, const Candidate& c) {
 }
 
 // The shortcut a ray may take: none when it is observed, in adversarial order or with shortcuts off;
-// FirstHit when no order can change its outcome; else Closest.
+// FirstHit when no order can change its outcome and no intersection shader of the pipeline runs in record groups
+// (FirstHit runs its candidates inside Embree's traversal, one ray at a time); else Closest.
 GatherMode traversalMode(const ThreadState& ts, const RayState& rs) {
     const DispatchState& ds = *ts.dispatch;
     if (!ds.options.specialise || observer(ts) || ds.options.order != TraversalOrder::Ordered) return GatherMode::All;
     const uint32_t firstHit = RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH | RAY_FLAG_SKIP_CLOSEST_HIT_SHADER;
-    if ((rs.effectiveFlags & firstHit) == firstHit && !ds.anyHitInPipeline) return GatherMode::FirstHit;
+    if ((rs.effectiveFlags & firstHit) == firstHit && !ds.anyHitInPipeline && !ds.waveIntersectionInPipeline)
+        return GatherMode::FirstHit;
     return GatherMode::Closest;
 }
 

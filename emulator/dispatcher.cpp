@@ -270,8 +270,10 @@ DispatchResult Device::dispatchRays(const DispatchRaysDesc& desc, const StateObj
 
     DispatchState ds;
     initDispatchState(ds, this, memory_, pipeline, desc, globalArguments, options, epoch_.load());
-    for (const ProgramEntry& entry : pipeline->entries())
+    for (const ProgramEntry& entry : pipeline->entries()) {
         if (entry.anyHit) ds.anyHitInPipeline = true;
+        if (entry.intersection && entry.intersection->waveIntersection) ds.waveIntersectionInPipeline = true;
+    }
     resolveRayGenerationRecord(ds);
 
     DispatchResult result;

@@ -21,7 +21,7 @@
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
-build_dir="$root/build/release"
+build_dir="$root/build/gpu-bundle"
 do_build=1
 target_ldconfig=""
 max_mib=50
@@ -40,7 +40,9 @@ bundle="$root/.gpu-bundle"
 # 1. The release binary and the SPIR-V.
 if [ "$do_build" = 1 ]; then
   export CMAKE_CXX_COMPILER_LAUNCHER=${CMAKE_CXX_COMPILER_LAUNCHER:-ccache} CMAKE_C_COMPILER_LAUNCHER=${CMAKE_C_COMPILER_LAUNCHER:-ccache}
-  (cd "$root" && cmake --preset release -DREFRAY_VULKAN=ON >/dev/null && cmake --build --preset release -j2 --target refray refray_spirv)
+  # For another machine's CPU: not -march=native (REFRAY_NATIVE_ARCH), in a build directory of its own.
+  (cd "$root" && cmake --preset release -B "$build_dir" -DREFRAY_VULKAN=ON -DREFRAY_NATIVE_ARCH=OFF >/dev/null &&
+     cmake --build "$build_dir" -j2 --target refray refray_spirv)
 fi
 binary="$build_dir/tools/refray"
 spirv="$build_dir/gpu/shaders"

@@ -23,6 +23,7 @@ struct DispatchState {
     RecordView rayGenRecord;
     const ShaderExport* computeShader = nullptr;  // Device::dispatch: the compute shader every launch runs
     bool anyHitInPipeline = false;  // a hit group of the pipeline names an any-hit shader
+    bool waveIntersectionInPipeline = false;  // a hit group's intersection shader is written for waves
     std::atomic<uint64_t> firstErrorIndex{~0ull};
 };
 

@@ -5,6 +5,7 @@
 
 #include <cstring>
 
+#include "emulator/intersection_wave.h"
 #include "emulator/shader_api.h"
 #include "procedural/math/analytic.h"
 #include "procedural/math/hlsl.h"
@@ -12,6 +13,7 @@
 #include "procedural/math/perturbed.h"
 #include "procedural/math/ray.h"
 #include "procedural/math/sdf.h"
+#include "procedural/wave_shader.h"
 
 namespace refray::procedural::d3d12 {
 
@@ -270,9 +272,10 @@ math::RayExtent<T> CurrentExtent(const ShaderContext& ctx) {
 // and the inline-tracing shaders, which intersect their procedural candidates themselves (scenes/inline/).
 enum class IntersectionShader : uint32_t { AnalyticPrimitive = 0, VolumetricPrimitive = 1, SignedDistancePrimitive = 2 };
 
+// PORT: hit is a LaneMask<T> (bool for a scalar T, one flag per ray for a wave's lanes).
 template <typename T>
 struct PrimitiveHit {
-    bool hit = false;
+    math::LaneMask<T> hit = math::LaneMask<T>(false);
     T thit = T(0);
     tvec3<T> normal{T(0)};  // local space
 };
@@ -739,20 +742,56 @@ void InlineAmbientOcclusionCS(ShaderContext& ctx, const TraceRayArgumentSet& tra
 }
 
 // Each intersection shader starts from zero-initialised attributes (H6) and reports HitKind 0 with the world normal.
+// The three intersection shaders (MyIntersectionShader_AnalyticPrimitive, _VolumetricPrimitive,
+// _SignedDistancePrimitive), run once over the lanes of a record group (emulator/intersection_wave.h).
+// PORT: each lane reads its own ray, record and constants, and reports its own hit, with the one-ray code in T; the
+// intersection test between them runs over the lanes at once (T's lanes, WaveLanes<T>). The lanes of a record group
+// share the record, so the primitive type is the group's.
 template <typename T>
-void IntersectionShaderOf(ShaderContext& ctx, IntersectionShader shader, const Accuracy& accuracy) {
-    [[maybe_unused]] PrecisionScope<T> scope;
-    const PrimitiveInstancePerFrameBuffer aabbAttribute = primitiveAttributes(ctx);
-    const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx, aabbAttribute);
-    const PrimitiveInstanceConstantBuffer aabb = aabbCB(ctx);
-    const T elapsedTime = shader == IntersectionShader::VolumetricPrimitive ? T(sceneCB(ctx).elapsedTime) : T(0);
-    const T stepScale = shader == IntersectionShader::SignedDistancePrimitive ? T(materialCB(ctx).stepScale) : T(1);
-    const PrimitiveHit<T> test =
-        IntersectPrimitive<T>(shader, aabb.primitiveType, localRay, CurrentExtent<T>(ctx), elapsedTime, stepScale, accuracy);
-    if (test.hit) {
-        const ProceduralPrimitiveAttributes attr{vec3(NormalToWorld(ctx.ObjectToWorld3x4(), aabbAttribute, test.normal))};
-        ctx.ReportHit(float(test.thit), /*hitKind*/ 0, attr);
+void IntersectionShaderOf(IntersectionWave& wave, IntersectionShader shader, const Accuracy& accuracy) {
+    using L = WaveLanes<T>;
+    [[maybe_unused]] PrecisionScope<L> scope;
+    struct LaneInput {
+        PrimitiveInstancePerFrameBuffer aabbAttribute;
+        math::Ray<T> localRay;
+        math::RayExtent<T> extent;
+        uint32_t primitiveType = 0;
+        T elapsedTime, stepScale;
+    };
+    const auto in = gatherLanes(wave, [shader](ShaderContext& ctx) {
+        LaneInput l;
+        l.aabbAttribute = primitiveAttributes(ctx);
+        l.localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx, l.aabbAttribute);
+        l.extent = CurrentExtent<T>(ctx);
+        l.primitiveType = aabbCB(ctx).primitiveType;
+        l.elapsedTime = shader == IntersectionShader::VolumetricPrimitive ? T(sceneCB(ctx).elapsedTime) : T(0);
+        l.stepScale = shader == IntersectionShader::SignedDistancePrimitive ? T(materialCB(ctx).stepScale) : T(1);
+        return l;
+    });
+    if (wave.active().empty()) return;
+    const math::LiveLanes live(wave.active().bits(), 0);  // duplicated inactive lanes skip libm's calls
+    math::Ray<L> localRay;
+    math::RayExtent<L> extent;
+    L elapsedTime, stepScale;
+    for (int i = 0; i < kMaxWaveWidth; ++i) {
+        const LaneInput& l = in[size_t(i)];
+        math::setLane(localRay.origin, i, l.localRay.origin);
+        math::setLane(localRay.direction, i, l.localRay.direction);
+        math::setLane(extent.tMin, i, l.extent.tMin);
+        math::setLane(extent.tCurrent, i, l.extent.tCurrent);
+        extent.cullBackFacing.v[i] = l.extent.cullBackFacing;
+        extent.cullFrontFacing.v[i] = l.extent.cullFrontFacing;
+        math::setLane(elapsedTime, i, l.elapsedTime);
+        math::setLane(stepScale, i, l.stepScale);
     }
+    const PrimitiveHit<L> test = IntersectPrimitive<L>(shader, in[size_t(wave.active().lowest())].primitiveType, localRay,
+                                                       extent, elapsedTime, stepScale, accuracy);
+    wave.forEachLane([&](int i, ShaderContext& ctx) {
+        if (!math::lane(test.hit, i)) return;
+        const ProceduralPrimitiveAttributes attr{
+            vec3(NormalToWorld(ctx.ObjectToWorld3x4(), in[size_t(i)].aabbAttribute, math::lane(test.normal, i)))};
+        wave.ReportHit(i, float(math::lane(test.thit, i)), /*hitKind*/ 0, attr);
+    });
 }
 
 // Every export, with its math in T. The lambdas hold copies of the TraceRay arguments and the Accuracy, which the
@@ -818,22 +857,22 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
     lib.addMiss<ShadowRayPayload>("MyMissShader_ShadowRay", MyMissShader_ShadowRay);
     // Each intersection shader's ReportHit is its last action, as in the HLSL: ReportHitEnd::Return spares the unwind
     // when a shadow ray's hit ends the search (docs/emulator.md, "Ending an intersection shader").
-    lib.addIntersection<ProceduralPrimitiveAttributes>(
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_AnalyticPrimitive",
-        in([accuracy](ShaderContext& ctx) {
-            IntersectionShaderOf<T>(ctx, IntersectionShader::AnalyticPrimitive, accuracy);
+        in([accuracy](IntersectionWave& wave) {
+            IntersectionShaderOf<T>(wave, IntersectionShader::AnalyticPrimitive, accuracy);
         }),
         ReportHitEnd::Return);
-    lib.addIntersection<ProceduralPrimitiveAttributes>(
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_VolumetricPrimitive",
-        in([accuracy](ShaderContext& ctx) {
-            IntersectionShaderOf<T>(ctx, IntersectionShader::VolumetricPrimitive, accuracy);
+        in([accuracy](IntersectionWave& wave) {
+            IntersectionShaderOf<T>(wave, IntersectionShader::VolumetricPrimitive, accuracy);
         }),
         ReportHitEnd::Return);
-    lib.addIntersection<ProceduralPrimitiveAttributes>(
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_SignedDistancePrimitive",
-        in([accuracy](ShaderContext& ctx) {
-            IntersectionShaderOf<T>(ctx, IntersectionShader::SignedDistancePrimitive, accuracy);
+        in([accuracy](IntersectionWave& wave) {
+            IntersectionShaderOf<T>(wave, IntersectionShader::SignedDistancePrimitive, accuracy);
         }),
         ReportHitEnd::Return);
 }

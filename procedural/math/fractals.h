@@ -42,6 +42,7 @@ T mdist(const vec3<T>& p, vec4<T>& resColor, int iterations = kIterations) {
     // PORT: the lanes that have broken out keep their values (`running`, see lanes.h); the loop ends when none runs.
     LaneMask<T> running = allLanesSet<T>();
     for (int i = 0; i < iterations && anyLane(running); i++) {
+        const LiveLanes live(running);
         // The non-PERFORMANCE branch (the live one). Exponents 7 and 8 are not the literal 2, so
         // DXC lowers both pows to exp2(y*log2(x)).
         const T dzNext = T(8) * hlsl::pow(hlsl::sqrt(m), T(7)) * dz + T(1);
@@ -136,6 +137,7 @@ MandelbulbHit<T> MandelbulbDistance(const vec3<T>& ro, const vec3<T>& rd, int iM
 
     LaneMask<T> running = inSphere;
     for (int i = 0; i < iMax && anyLane(running); i++) {
+        const LiveLanes live(running);
         const vec3<T> posNext = ro + rd * t;
         const T th = params.threshold * t;
         vec4<T> trapNext;
@@ -221,6 +223,7 @@ vec2<T> jdist(const vec3<T>& p, const vec4<T>& c, int iMax, LaneMask<T> lanes = 
     T n = T(0);
     LaneMask<T> running = lanes;
     for (int i = 0; i < iMax && anyLane(running); i++) {
+        const LiveLanes live(running);
         const T dz2Next = dz2 * (T(9) * qLength2_float4(qSquare_float4(z)));  // dz2 *= 9*|z^2|^2
         const vec4<T> zNext = qCube_float4(z) + c;
         const T m2Next = qLength2_float4(zNext);
@@ -302,6 +305,7 @@ vec2<T> raycast(const vec3<T>& ro, const vec3<T>& rd, const vec4<T>& c = kc<T>()
     // HLSL has at its break. jdist leaves out the lanes that no longer march.
     LaneMask<T> running = !ruledOut;
     for (int i = 0; i < maxSteps && anyLane(running); i++) {
+        const LiveLanes live(running);
         res = select(running, jdist(ro + (rd * t), c, iMax, running), res);
         running = running && !(res.x < precis);  // if (res.x < precis) break;
         lt = select(running, t, lt);

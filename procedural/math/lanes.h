@@ -14,37 +14,60 @@
 
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <cstdint>
 #include <type_traits>
 
 #include "procedural/math/hlsl.h"
+
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
 
 namespace refray::procedural::math {
 
 // The widest wave: 16 floats, one AVX-512 register (docs/emulator.md says why 16).
 inline constexpr int kMaxLanes = 16;
 
+namespace detail {
+// The storage of N lanes of S: a GCC vector (operators become SIMD instructions, kept in registers where they fit)
+// for the built-in arithmetic types, an array for any other scalar type (PerturbedFloat).
+template <class S, int N, bool kVector = std::is_arithmetic_v<S> && !std::is_same_v<S, bool>>
+struct LaneStorage {
+    using type = S[N];
+    static constexpr bool kIsVector = false;
+};
+template <class S, int N>
+struct LaneStorage<S, N, true> {
+    typedef S type __attribute__((vector_size(sizeof(S) * N)));
+    static constexpr bool kIsVector = true;
+};
+// The signed integer of S's width: what a vector comparison of S lanes gives per lane (-1 or 0).
+template <class S>
+using LaneCompareInt = std::conditional_t<sizeof(S) == 8, int64_t, std::conditional_t<sizeof(S) == 4, int32_t,
+                                          std::conditional_t<sizeof(S) == 2, int16_t, int8_t>>>;
+}  // namespace detail
+
 template <int N>
 struct LaneBools {
-    bool v[N];
+    // 0 or 1 per lane, as wide as a float lane so that selects on float lanes vectorise.
+    using Storage = typename detail::LaneStorage<uint32_t, N>::type;
+    Storage v;
 
     LaneBools() = default;
-    constexpr explicit LaneBools(bool b) {
-        for (int i = 0; i < N; ++i) v[i] = b;
-    }
-    constexpr bool operator[](int i) const { return v[i]; }
-    constexpr bool& operator[](int i) { return v[i]; }
+    constexpr explicit LaneBools(bool b) : v(Storage{} + (b ? 1u : 0u)) {}
+    constexpr bool operator[](int i) const { return v[i] != 0; }
 
     friend constexpr LaneBools operator&(LaneBools a, LaneBools b) {
-        for (int i = 0; i < N; ++i) a.v[i] = a.v[i] && b.v[i];
+        a.v &= b.v;
         return a;
     }
     friend constexpr LaneBools operator|(LaneBools a, LaneBools b) {
-        for (int i = 0; i < N; ++i) a.v[i] = a.v[i] || b.v[i];
+        a.v |= b.v;
         return a;
     }
     friend constexpr LaneBools operator!(LaneBools a) {
-        for (int i = 0; i < N; ++i) a.v[i] = !a.v[i];
+        a.v ^= 1u;
         return a;
     }
     // && and || on masks are the lane-wise & and | (both sides are evaluated, as in a shader's SIMD code).
@@ -59,7 +82,9 @@ struct Lanes {
     static_assert(std::is_trivially_default_constructible_v<S>, "GLM keeps components in unions");
     using Scalar = S;
     static constexpr int kCount = N;
-    S v[N];
+    static constexpr bool kVector = detail::LaneStorage<S, N>::kIsVector;
+    using Storage = typename detail::LaneStorage<S, N>::type;
+    Storage v;
 
     Lanes() = default;
     // The same value in every lane: T(0.5f), T(ratio), and GLM's static_cast from float.
@@ -67,10 +92,13 @@ struct Lanes {
         requires std::is_arithmetic_v<U> || std::is_same_v<U, S>
     constexpr Lanes(U x) {  // NOLINT: implicit, as a scalar literal promotes in HLSL
         const S s = S(x);
-        for (int i = 0; i < N; ++i) v[i] = s;
+        if constexpr (kVector) {
+            v = Storage{} + s;
+        } else {
+            for (int i = 0; i < N; ++i) v[i] = s;
+        }
     }
     constexpr S operator[](int i) const { return v[i]; }
-    constexpr S& operator[](int i) { return v[i]; }
 
     template <class F>
     static Lanes generate(F f) {
@@ -79,12 +107,16 @@ struct Lanes {
         return r;
     }
 
-#define REFRAY_LANES_BINARY(op)                                        \
-    friend Lanes operator op(const Lanes& a, const Lanes& b) {         \
-        Lanes r;                                                       \
-        for (int i = 0; i < N; ++i) r.v[i] = a.v[i] op b.v[i];         \
-        return r;                                                      \
-    }                                                                  \
+#define REFRAY_LANES_BINARY(op)                                                 \
+    friend Lanes operator op(const Lanes& a, const Lanes& b) {                  \
+        Lanes r;                                                                \
+        if constexpr (kVector) {                                                \
+            r.v = a.v op b.v;                                                   \
+        } else {                                                                \
+            for (int i = 0; i < N; ++i) r.v[i] = a.v[i] op b.v[i];              \
+        }                                                                       \
+        return r;                                                               \
+    }                                                                           \
     Lanes& operator op##=(const Lanes& b) { return *this = *this op b; }
     REFRAY_LANES_BINARY(+)
     REFRAY_LANES_BINARY(-)
@@ -93,16 +125,24 @@ struct Lanes {
 #undef REFRAY_LANES_BINARY
     friend Lanes operator-(const Lanes& a) {
         Lanes r;
-        for (int i = 0; i < N; ++i) r.v[i] = -a.v[i];
+        if constexpr (kVector) {
+            r.v = -a.v;
+        } else {
+            for (int i = 0; i < N; ++i) r.v[i] = -a.v[i];
+        }
         return r;
     }
     friend Lanes operator+(const Lanes& a) { return a; }
 
-#define REFRAY_LANES_COMPARE(op)                                              \
-    friend LaneBools<N> operator op(const Lanes& a, const Lanes& b) {         \
-        LaneBools<N> r;                                                       \
-        for (int i = 0; i < N; ++i) r.v[i] = a.v[i] op b.v[i];                \
-        return r;                                                             \
+#define REFRAY_LANES_COMPARE(op)                                                                     \
+    friend LaneBools<N> operator op(const Lanes& a, const Lanes& b) {                                \
+        LaneBools<N> r;                                                                              \
+        if constexpr (kVector && sizeof(S) == 4) {                                                   \
+            r.v = typename LaneBools<N>::Storage(a.v op b.v) & 1u;                                   \
+        } else {                                                                                     \
+            for (int i = 0; i < N; ++i) r.v[i] = a.v[i] op b.v[i];                                   \
+        }                                                                                            \
+        return r;                                                                                    \
     }
     REFRAY_LANES_COMPARE(<)
     REFRAY_LANES_COMPARE(<=)
@@ -141,16 +181,16 @@ constexpr LaneMask<T> allLanesSet() { return LaneMask<T>(true); }
 constexpr bool anyLane(bool m) { return m; }
 template <int N>
 constexpr bool anyLane(const LaneBools<N>& m) {
-    bool any = false;
-    for (int i = 0; i < N; ++i) any = any || m.v[i];
-    return any;
+    uint32_t any = 0;
+    for (int i = 0; i < N; ++i) any |= m.v[i];
+    return any != 0;
 }
 constexpr bool allLanes(bool m) { return m; }
 template <int N>
 constexpr bool allLanes(const LaneBools<N>& m) {
-    bool all = true;
-    for (int i = 0; i < N; ++i) all = all && m.v[i];
-    return all;
+    uint32_t all = 1;
+    for (int i = 0; i < N; ++i) all &= m.v[i];
+    return all != 0;
 }
 
 // m ? a : b, lane by lane; for a scalar mask, the plain conditional.
@@ -162,11 +202,15 @@ T select(bool m, const T& a, const T& b) {
 template <class S, int N>
 Lanes<S, N> select(const LaneBools<N>& m, const Lanes<S, N>& a, const Lanes<S, N>& b) {
     Lanes<S, N> r;
-    for (int i = 0; i < N; ++i) r.v[i] = m.v[i] ? a.v[i] : b.v[i];
+    if constexpr (Lanes<S, N>::kVector && sizeof(S) == 4) {
+        r.v = m.v != 0u ? a.v : b.v;
+    } else {
+        for (int i = 0; i < N; ++i) r.v[i] = m.v[i] ? a.v[i] : b.v[i];
+    }
     return r;
 }
 template <int N>
-LaneBools<N> select(const LaneBools<N>& m, const LaneBools<N>& a, const LaneBools<N>& b) {
+LaneBools<N> select(const LaneBools<N>& m, const LaneBools<N>& a, const LaneBools<N>& b) {  // NOLINT
     return (m & a) | (!m & b);
 }
 // Vectors of lanes (GLM's vec<K, Lanes>), component by component.
@@ -177,6 +221,34 @@ glm::vec<K, Lanes<S, N>, Q> select(const LaneBools<N>& m, const glm::vec<K, Lane
     for (glm::length_t k = 0; k < K; ++k) r[k] = select(m, a[k], b[k]);
     return r;
 }
+
+// The lanes whose results still count, while a march runs (its `running` mask within the shader's active lanes):
+// the instructions a compiler cannot vectorise (libm's transcendentals, called lane by lane) are computed for these
+// lanes only, and the others keep their operand. Sound because a march keeps each new value only in its running
+// lanes (select), so what a stopped lane computes is never read. A scope narrows the enclosing one for its
+// lifetime; for a scalar mask it does nothing. Per thread: a wave's shader runs on its worker without switching.
+inline thread_local uint32_t tLiveLanes = ~0u;
+class LiveLanes {
+public:
+    explicit LiveLanes(bool) {}
+    template <int N>
+    explicit LiveLanes(const LaneBools<N>& m) : saved_(tLiveLanes), restore_(true) {
+        uint32_t bits = 0;
+        for (int i = 0; i < N; ++i) bits |= (m.v[i] & 1u) << i;
+        tLiveLanes = saved_ & bits;
+    }
+    // A wave shader's active lanes (bit i: lane i), for the whole shader.
+    LiveLanes(uint32_t bits, int) : saved_(tLiveLanes), restore_(true) { tLiveLanes = bits; }
+    ~LiveLanes() {
+        if (restore_) tLiveLanes = saved_;
+    }
+    LiveLanes(const LiveLanes&) = delete;
+    LiveLanes& operator=(const LiveLanes&) = delete;
+
+private:
+    uint32_t saved_ = 0;
+    bool restore_ = false;
+};
 
 // Lane i of a scalar is the scalar; of lanes, its lane i.
 template <class T>
@@ -197,7 +269,7 @@ glm::vec<K, S, Q> lane(const glm::vec<K, Lanes<S, N>, Q>& x, int i) {
 constexpr bool lane(bool m, int) { return m; }
 template <int N>
 constexpr bool lane(const LaneBools<N>& m, int i) {
-    return m.v[i];
+    return m.v[i] != 0;
 }
 
 // Writes lane i (the whole value for a scalar).
@@ -237,13 +309,33 @@ struct ScalarOps<math::Lanes<S, N>> {
         for (int i = 0; i < N; ++i) r.v[i] = f(a.v[i], b.v[i]);
         return r;
     }
+    // map for the live lanes only (math::LiveLanes); the others keep their operand.
+    template <class F>
+    static L mapLive(const L& a, F f) {
+        L r = a;
+        for (uint32_t live = math::tLiveLanes & ((N >= 32 ? 0u : (1u << N)) - 1u); live; live &= live - 1) {
+            const int i = std::countr_zero(live);
+            r.v[i] = f(a.v[i]);
+        }
+        return r;
+    }
+    template <class F>
+    static L mapLive(const L& a, const L& b, F f) {
+        L r = a;
+        for (uint32_t live = math::tLiveLanes & ((N >= 32 ? 0u : (1u << N)) - 1u); live; live &= live - 1) {
+            const int i = std::countr_zero(live);
+            r.v[i] = f(a.v[i], b.v[i]);
+        }
+        return r;
+    }
     static constexpr bool kFloat = std::is_same_v<S, float>;
     // float lanes: the instructions a compiler can vectorise, each bit for bit libm's (glibc's fabsf, floorf, sqrtf,
     // fminf and fmaxf; the lanes test checks them on special values), so that the wave math runs in SIMD registers.
+    using Bits = typename math::detail::LaneStorage<uint32_t, N>::type;
     static L abs(const L& x) {
         if constexpr (kFloat) {
             L r;
-            for (int i = 0; i < N; ++i) r.v[i] = std::bit_cast<float>(std::bit_cast<uint32_t>(x.v[i]) & 0x7fffffffu);
+            r.v = typename L::Storage(Bits(x.v) & 0x7fffffffu);
             return r;
         } else {
             return map(x, [](S a) { return ScalarOps<S>::abs(a); });
@@ -253,46 +345,76 @@ struct ScalarOps<math::Lanes<S, N>> {
         if constexpr (kFloat) {
             // Below 2^23 in magnitude: truncate, step down where that rounded up, keep the sign (floor(-0) = -0);
             // from 2^23 on (and NaN, infinity) every float is its own floor.
+            using F = typename L::Storage;
+            using I = typename math::detail::LaneStorage<int32_t, N>::type;
+            const F a = x.v;
+            const F magnitude = F(Bits(a) & 0x7fffffffu);
+            const auto small = magnitude < 0x1p23f;
+            F t = __builtin_convertvector(__builtin_convertvector(small ? a : F{}, I), F);
+            t = t > a ? t - 1.0f : t;
+            t = F((Bits(t) & 0x7fffffffu) | (Bits(a) & 0x80000000u));
             L r;
-            for (int i = 0; i < N; ++i) {
-                const float a = x.v[i];
-                float t = float(int32_t(std::bit_cast<float>(std::bit_cast<uint32_t>(a) & 0x7fffffffu) < 0x1p23f ? a : 0.0f));
-                t = t > a ? t - 1.0f : t;
-                t = std::bit_cast<float>((std::bit_cast<uint32_t>(t) & 0x7fffffffu) | (std::bit_cast<uint32_t>(a) & 0x80000000u));
-                r.v[i] = std::bit_cast<float>(std::bit_cast<uint32_t>(a) & 0x7fffffffu) < 0x1p23f ? t : a;
-            }
+            r.v = small ? t : a;
             return r;
         } else {
             return map(x, [](S a) { return ScalarOps<S>::floor(a); });
         }
     }
     static L sqrt(const L& x) {
-#if REFRAY_HAS_MXCSR
         if constexpr (kFloat && N % 4 == 0) {
+            // sqrtps: correctly rounded, as sqrtf; the widest the target has.
             L r;
-            for (int i = 0; i < N; i += 4) _mm_storeu_ps(r.v + i, _mm_sqrt_ps(_mm_loadu_ps(x.v + i)));
-            return r;
-        }
+#if defined(__AVX512F__)
+            if constexpr (N % 16 == 0) {
+                for (int i = 0; i < N; i += 16) {
+                    __m512 p;
+                    std::memcpy(&p, reinterpret_cast<const char*>(&x.v) + i * 4, 64);
+                    p = _mm512_maskz_sqrt_ps(__mmask16(0xFFFF), p);  // (the unmasked form trips -Wmaybe-uninitialized in GCC 12)
+                    std::memcpy(reinterpret_cast<char*>(&r.v) + i * 4, &p, 64);
+                }
+                return r;
+            }
 #endif
+#if defined(__AVX__)
+            if constexpr (N % 8 == 0) {
+                for (int i = 0; i < N; i += 8) {
+                    __m256 p;
+                    std::memcpy(&p, reinterpret_cast<const char*>(&x.v) + i * 4, 32);
+                    p = _mm256_sqrt_ps(p);
+                    std::memcpy(reinterpret_cast<char*>(&r.v) + i * 4, &p, 32);
+                }
+                return r;
+            }
+#endif
+#if REFRAY_HAS_MXCSR
+            for (int i = 0; i < N; i += 4) {
+                __m128 p;
+                std::memcpy(&p, reinterpret_cast<const char*>(&x.v) + i * 4, 16);
+                p = _mm_sqrt_ps(p);
+                std::memcpy(reinterpret_cast<char*>(&r.v) + i * 4, &p, 16);
+            }
+            return r;
+#endif
+        }
         return map(x, [](S a) { return ScalarOps<S>::sqrt(a); });
     }
     static L rsqrt(const L& x) {
         if constexpr (kFloat) return L(1.0f) / sqrt(x);
         else return map(x, [](S a) { return ScalarOps<S>::rsqrt(a); });
     }
-    static L sin(const L& x) { return map(x, [](S a) { return ScalarOps<S>::sin(a); }); }
-    static L cos(const L& x) { return map(x, [](S a) { return ScalarOps<S>::cos(a); }); }
-    static L acos(const L& x) { return map(x, [](S a) { return ScalarOps<S>::acos(a); }); }
-    static L atan(const L& x) { return map(x, [](S a) { return ScalarOps<S>::atan(a); }); }
-    static L exp2(const L& x) { return map(x, [](S a) { return ScalarOps<S>::exp2(a); }); }
-    static L log2(const L& x) { return map(x, [](S a) { return ScalarOps<S>::log2(a); }); }
+    static L sin(const L& x) { return mapLive(x, [](S a) { return ScalarOps<S>::sin(a); }); }
+    static L cos(const L& x) { return mapLive(x, [](S a) { return ScalarOps<S>::cos(a); }); }
+    static L acos(const L& x) { return mapLive(x, [](S a) { return ScalarOps<S>::acos(a); }); }
+    static L atan(const L& x) { return mapLive(x, [](S a) { return ScalarOps<S>::atan(a); }); }
+    static L exp2(const L& x) { return mapLive(x, [](S a) { return ScalarOps<S>::exp2(a); }); }
+    static L log2(const L& x) { return mapLive(x, [](S a) { return ScalarOps<S>::log2(a); }); }
     // glibc's fminf/fmaxf: the first operand when the two compare equal (so min(+0, -0) = +0), the other operand
     // when one is a quiet NaN, the second when both are. (Signalling NaNs, which no arithmetic makes, are not
     // quietened as libm does.)
     static L min(const L& a, const L& b) {
         if constexpr (kFloat) {
             L r;
-            for (int i = 0; i < N; ++i) r.v[i] = (a.v[i] <= b.v[i] || (b.v[i] != b.v[i] && a.v[i] == a.v[i])) ? a.v[i] : b.v[i];
+            r.v = ((a.v <= b.v) | ((b.v != b.v) & (a.v == a.v))) ? a.v : b.v;
             return r;
         } else {
             return map(a, b, [](S x, S y) { return ScalarOps<S>::min(x, y); });
@@ -301,16 +423,22 @@ struct ScalarOps<math::Lanes<S, N>> {
     static L max(const L& a, const L& b) {
         if constexpr (kFloat) {
             L r;
-            for (int i = 0; i < N; ++i) r.v[i] = (a.v[i] >= b.v[i] || (b.v[i] != b.v[i] && a.v[i] == a.v[i])) ? a.v[i] : b.v[i];
+            r.v = ((a.v >= b.v) | ((b.v != b.v) & (a.v == a.v))) ? a.v : b.v;
             return r;
         } else {
             return map(a, b, [](S x, S y) { return ScalarOps<S>::max(x, y); });
         }
     }
-    static L frem(const L& a, const L& b) { return map(a, b, [](S x, S y) { return ScalarOps<S>::frem(x, y); }); }
-    // The scalar type's dot, lane by lane (its order of terms and its rounding).
+    static L frem(const L& a, const L& b) { return mapLive(a, b, [](S x, S y) { return ScalarOps<S>::frem(x, y); }); }
+    // The scalar type's dot, lane by lane (its order of terms and its rounding): for float and double the plain sum
+    // of products in component order, over all lanes at once.
     template <glm::length_t K, glm::qualifier Q>
     static L dot(const glm::vec<K, L, Q>& a, const glm::vec<K, L, Q>& b) {
+        if constexpr (std::is_floating_point_v<S>) {
+            L s = a[0] * b[0];
+            for (glm::length_t k = 1; k < K; ++k) s = s + a[k] * b[k];
+            return s;
+        }
         L r;
         for (int i = 0; i < N; ++i) {
             glm::vec<K, S, Q> x, y;
@@ -328,15 +456,28 @@ struct ScalarOps<math::Lanes<S, N>> {
 // scalar templates, so overload resolution picks these for lanes.
 template <class S, int N>
 math::Lanes<S, N> step(math::Lanes<S, N> a, math::Lanes<S, N> x) {
-    return math::Lanes<S, N>::generate([&](int i) { return hlsl::step(a.v[i], x.v[i]); });
+    return math::select(x >= a, math::Lanes<S, N>(S(1)), math::Lanes<S, N>(S(0)));
 }
 template <class S, int N>
 math::Lanes<S, N> atan2(math::Lanes<S, N> y, math::Lanes<S, N> x) {
-    return math::Lanes<S, N>::generate([&](int i) { return hlsl::atan2(y.v[i], x.v[i]); });
+    using L = math::Lanes<S, N>;
+    L r = ScalarOps<L>::atan(y / x);
+    const L pi(kPi<S>);
+    const auto xLt0 = x < L(S(0));
+    const auto xEq0 = x == L(S(0));
+    const auto yGe0 = y >= L(S(0));
+    const auto yLt0 = y < L(S(0));
+    r = math::select(xLt0 && yGe0, r + pi, r);
+    r = math::select(xLt0 && yLt0, r - pi, r);
+    r = math::select(xEq0 && yLt0, -pi / L(S(2)), r);
+    r = math::select(xEq0 && yGe0, pi / L(S(2)), r);
+    return r;
 }
 template <class S, int N>
 math::Lanes<S, N> fmod(math::Lanes<S, N> x, math::Lanes<S, N> y) {
-    return math::Lanes<S, N>::generate([&](int i) { return hlsl::fmod(x.v[i], y.v[i]); });
+    const math::Lanes<S, N> q = x / y;
+    const math::Lanes<S, N> f = frac(hlsl::abs(q));
+    return math::select(q >= -q, f, -f) * y;
 }
 
 }  // namespace refray::procedural::hlsl

@@ -156,6 +156,7 @@ MetaballsHit<T> RayMetaballsIntersectionTest(const Ray<T>& ray, const RayExtent<
     LaneMask<T> running = allLanesSet<T>();
 
     while (iStep++ < MAX_STEPS && anyLane(running)) {
+        const LiveLanes live(running);
         const vec3<T> position = ray.origin + t * ray.direction;
         T sumFieldPotential = T(0);
         for (int j = 0; j < N_METABALLS; j++) {

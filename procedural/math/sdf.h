@@ -292,6 +292,7 @@ SphereTraceResult<T> RaySignedDistancePrimitiveTest(const Ray<T>& ray, const Ray
     while (i++ < params.maxSteps) {
         running = running && t <= extent.tCurrent;  // PORT: the loop's `&& t <= RayTCurrent()`, per ray
         if (!anyLane(running)) break;
+        const LiveLanes live(running);
         result.steps = select(running, LaneUint<T>(i), result.steps);
         const vec3<T> position = ray.origin + t * ray.direction;
         const T distance = sdf(position);

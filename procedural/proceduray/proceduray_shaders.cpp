@@ -2,14 +2,17 @@
 // Triangles.hlsli, Pacman.hlsli, JuliaSets.hlsli, Mandelbulb.hlsli entry points; see proceduray_shaders.h.
 #include "procedural/proceduray/proceduray_shaders.h"
 
+#include <array>
 #include <cstring>
 
+#include "emulator/intersection_wave.h"
 #include "emulator/shader_api.h"
 #include "procedural/math/fractals.h"
 #include "procedural/math/hlsl.h"
 #include "procedural/math/perturbed.h"
 #include "procedural/math/ray.h"
 #include "procedural/math/sdf.h"
+#include "procedural/wave_shader.h"
 
 namespace refray::procedural::proceduray {
 
@@ -409,34 +412,91 @@ void ClosestHit_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay
     rayPayload.color = vec4(color);
 }
 
+// ---- The intersection shaders, run over the lanes of a record group (emulator/intersection_wave.h) ----------------
+// PORT: each lane reads its own ray, record and constants and reports its own hit with the one-ray code in T; the
+// march between runs over the lanes at once (WaveLanes<T>). Lanes of a record group share its record (primitive
+// type, instance index, step scale).
+
+// What one lane of an intersection shader reads before its march.
 template <typename T>
-void Intersection_Pacman(ShaderContext& ctx, const Accuracy& accuracy) {
-    [[maybe_unused]] PrecisionScope<T> scope;
-    const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx);
-    const auto primitiveType = SignedDistancePrimitive(aabbCB(ctx).primitiveType);
-    ProceduralPrimitiveAttributes attr = kInitialAttributes;
+struct LaneInput {
+    math::Ray<T> localRay;
+    math::RayExtent<T> extent;
+    SceneConstantBuffer sceneCB;
+    PrimitiveInstanceConstantBuffer aabbCB;
+    float stepScale = 0.0f;
+};
 
-    const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
-    if (g_sceneCB.debugFlag) {
-        ctx.ReportHit(0.0f, 1, attr);
-        return;
+template <typename T>
+LaneInput<T> readLane(const ShaderContext& ctx) {
+    LaneInput<T> in;
+    in.localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx);
+    in.extent = CurrentExtent<T>(ctx);
+    in.sceneCB = sceneCB(ctx);
+    in.aabbCB = aabbCB(ctx);
+    in.stepScale = materialCB(ctx).stepScale;
+    return in;
+}
+
+template <typename T>
+math::Ray<WaveLanes<T>> waveRay(const std::array<LaneInput<T>, kMaxWaveWidth>& in) {
+    math::Ray<WaveLanes<T>> ray;
+    for (int i = 0; i < kMaxWaveWidth; ++i) {
+        math::setLane(ray.origin, i, in[size_t(i)].localRay.origin);
+        math::setLane(ray.direction, i, in[size_t(i)].localRay.direction);
     }
+    return ray;
+}
 
-    const T mouth = math::pacman::PacmanMouthInterpolant(T(g_sceneCB.elapsedTime));
+// `if (g_sceneCB.debugFlag) { ReportHit(0, 1, attr); return; }` for every lane; returns the lanes that go on.
+template <typename T>
+LaneMask reportDebugHits(IntersectionWave& wave, const std::array<LaneInput<T>, kMaxWaveWidth>& in) {
+    LaneMask marching;
+    for (int i : wave.active()) {
+        if (in[size_t(i)].sceneCB.debugFlag) wave.ReportHit(i, 0.0f, 1, kInitialAttributes);
+        else marching.set(i);
+    }
+    return marching;
+}
+
+template <typename T>
+void Intersection_Pacman(IntersectionWave& wave, const Accuracy& accuracy) {
+    using L = WaveLanes<T>;
+    [[maybe_unused]] PrecisionScope<L> scope;
+    const auto in = gatherLanes(wave, [](ShaderContext& ctx) { return readLane<T>(ctx); });
+    const LaneMask marching = reportDebugHits(wave, in);
+    if (marching.empty()) return;
+    const math::LiveLanes live(marching.bits(), 0);  // duplicated and debug lanes skip libm's calls
+    const LaneInput<T>& group = in[size_t(marching.lowest())];
+    const math::Ray<L> localRay = waveRay(in);
+    math::RayExtent<L> extent;
+    for (int i = 0; i < kMaxWaveWidth; ++i) {
+        math::setLane(extent.tMin, i, in[size_t(i)].extent.tMin);
+        math::setLane(extent.tCurrent, i, in[size_t(i)].extent.tCurrent);
+        extent.cullBackFacing.v[i] = in[size_t(i)].extent.cullBackFacing;
+        extent.cullFrontFacing.v[i] = in[size_t(i)].extent.cullFrontFacing;
+    }
+    const auto primitiveType = SignedDistancePrimitive(group.aabbCB.primitiveType);
+
+    const L mouth = L(math::pacman::PacmanMouthInterpolant(T(group.sceneCB.elapsedTime)));
     // PORT: the march's threshold, step limit and normal offset come from the library's Accuracy.
-    const math::SphereTraceParams<T> params = sphereTraceParams(accuracy, T(materialCB(ctx).stepScale));
-    const auto sdf = [primitiveType, mouth](const tvec3<T>& p) {
+    const math::SphereTraceParams<L> params = sphereTraceParams(accuracy, L(T(group.stepScale)));
+    const auto sdf = [primitiveType, mouth](const tvec3<L>& p) {
         return GetDistanceFromSignedDistancePrimitive(p, primitiveType, mouth);
     };
-    const math::SphereTraceResult<T> primitiveTest =
-        math::RaySignedDistancePrimitiveTest(localRay, CurrentExtent<T>(ctx), sdf, params);
+    const math::SphereTraceResult<L> primitiveTest = math::RaySignedDistancePrimitiveTest(localRay, extent, sdf, params);
 
     // H1: thit is in normalised local units, compared with and reported as if it were world t.
-    if (primitiveTest.hit && primitiveTest.thit < T(ctx.RayTCurrent())) {
-        attr.color = vec4(math::pacman::PacmanHitColor(primitiveTest.normal, primitiveTest.position));
-        attr.normal = vec3(NormalToWorld(ctx, primitiveTest.normal));
-        ctx.ReportHit(float(primitiveTest.thit), /*hitKind*/ 0, attr);
-    }
+    wave.forEachLane([&](int i, ShaderContext& ctx) {
+        if (!marching.test(i)) return;
+        const T thit = math::lane(primitiveTest.thit, i);
+        if (!(math::lane(primitiveTest.hit, i) && thit < T(in[size_t(i)].extent.tCurrent))) return;
+        const tvec3<T> normal = math::lane(primitiveTest.normal, i);
+        ProceduralPrimitiveAttributes attr = kInitialAttributes;
+        attr.color = vec4(math::pacman::PacmanHitColor(normal, math::lane(primitiveTest.position, i)));
+        attr.normal = vec3(NormalToWorld(ctx, normal));
+        wave.ReportHit(i, float(thit), /*hitKind*/ 0, attr);
+    });
 }
 
 template <typename T>
@@ -471,32 +531,35 @@ void ClosestHit_Pacman(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, 
 }
 
 template <typename T>
-void Intersection_Mandelbulb(ShaderContext& ctx, const Accuracy& accuracy) {
-    [[maybe_unused]] PrecisionScope<T> scope;
-    const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx);
-    ProceduralPrimitiveAttributes attr = kInitialAttributes;
-
-    const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
-    if (g_sceneCB.debugFlag) {
-        ctx.ReportHit(0.0f, 1, attr);
-        return;
-    }
+void Intersection_Mandelbulb(IntersectionWave& wave, const Accuracy& accuracy) {
+    using L = WaveLanes<T>;
+    [[maybe_unused]] PrecisionScope<L> scope;
+    const auto in = gatherLanes(wave, [](ShaderContext& ctx) { return readLane<T>(ctx); });
+    const LaneMask marching = reportDebugHits(wave, in);
+    if (marching.empty()) return;
+    const math::LiveLanes live(marching.bits(), 0);  // duplicated and debug lanes skip libm's calls
+    const LaneInput<T>& group = in[size_t(marching.lowest())];
 
     // The step count animates with time and the procedural instance ordinal (not InstanceIndex()).
     // l_materialCB.stepScale is passed by the HLSL but never used, so it is not read here.
     // PORT: the step count is scaled, and the threshold, iterations and normal offset come, from the library's
     // Accuracy.
     const int iMax = mandelbulbStepCount(
-        math::mandelbulb::MandelbulbIterationCount(T(g_sceneCB.elapsedTime), int(aabbCB(ctx).instanceIndex)),
+        math::mandelbulb::MandelbulbIterationCount(T(group.sceneCB.elapsedTime), int(group.aabbCB.instanceIndex)),
         accuracy);
-    const math::mandelbulb::MandelbulbHit<T> primitiveTest =
-        math::mandelbulb::MandelbulbDistance(localRay.origin, localRay.direction, iMax, mandelbulbParams<T>(accuracy));
+    const math::Ray<L> localRay = waveRay(in);
+    const math::mandelbulb::MandelbulbHit<L> primitiveTest =
+        math::mandelbulb::MandelbulbDistance(localRay.origin, localRay.direction, iMax, mandelbulbParams<L>(accuracy));
 
-    if (primitiveTest.hit && primitiveTest.thit < T(ctx.RayTCurrent())) {
-        attr.color = vec4(primitiveTest.color);
-        attr.normal = vec3(NormalToWorld(ctx, primitiveTest.normal));
-        ctx.ReportHit(float(primitiveTest.thit), /*hitKind*/ 0, attr);
-    }
+    wave.forEachLane([&](int i, ShaderContext& ctx) {
+        if (!marching.test(i)) return;
+        const T thit = math::lane(primitiveTest.thit, i);
+        if (!(math::lane(primitiveTest.hit, i) && thit < T(in[size_t(i)].extent.tCurrent))) return;
+        ProceduralPrimitiveAttributes attr = kInitialAttributes;
+        attr.color = vec4(math::lane(primitiveTest.color, i));
+        attr.normal = vec3(NormalToWorld(ctx, math::lane(primitiveTest.normal, i)));
+        wave.ReportHit(i, float(thit), /*hitKind*/ 0, attr);
+    });
 }
 
 template <typename T>
@@ -525,29 +588,30 @@ void ClosestHit_Mandelbulb(ShaderContext& ctx, const TraceRayArgumentSet& traceR
 }
 
 template <typename T>
-void Intersection_Julia(ShaderContext& ctx, const Accuracy& accuracy) {
-    [[maybe_unused]] PrecisionScope<T> scope;
-    const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx);
-    ProceduralPrimitiveAttributes attr = kInitialAttributes;
-
-    const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
-    if (g_sceneCB.debugFlag) {
-        ctx.ReportHit(0.0f, 1, attr);
-        return;
-    }
+void Intersection_Julia(IntersectionWave& wave, const Accuracy& accuracy) {
+    using L = WaveLanes<T>;
+    [[maybe_unused]] PrecisionScope<L> scope;
+    const auto in = gatherLanes(wave, [](ShaderContext& ctx) { return readLane<T>(ctx); });
+    const LaneMask marching = reportDebugHits(wave, in);
+    if (marching.empty()) return;
+    const math::LiveLanes live(marching.bits(), 0);  // duplicated and debug lanes skip libm's calls
 
     // PORT: JuliaDistance takes no time; the HLSL's cut animation is computed and then ignored (§5.5).
     // PORT: the iterations, march steps, stop precision and normal offset come from the library's Accuracy.
-    const math::julia::JuliaHit<T> primitiveTest =
-        math::julia::JuliaDistance(localRay.origin, localRay.direction, juliaParams<T>(accuracy));
-    const tvec2<T> thit = primitiveTest.resT;
+    const math::Ray<L> localRay = waveRay(in);
+    const math::julia::JuliaHit<L> primitiveTest =
+        math::julia::JuliaDistance(localRay.origin, localRay.direction, juliaParams<L>(accuracy));
 
     // H1: thit.x is in q-space units (0.4 x normalised local units).
-    if (primitiveTest.hit && thit.x < T(ctx.RayTCurrent())) {
-        attr.normal = vec3(NormalToWorld(ctx, primitiveTest.normal));
+    wave.forEachLane([&](int i, ShaderContext& ctx) {
+        if (!marching.test(i)) return;
+        const tvec2<T> thit = math::lane(primitiveTest.resT, i);
+        if (!(math::lane(primitiveTest.hit, i) && thit.x < T(in[size_t(i)].extent.tCurrent))) return;
+        ProceduralPrimitiveAttributes attr = kInitialAttributes;
+        attr.normal = vec3(NormalToWorld(ctx, math::lane(primitiveTest.normal, i)));
         attr.color = vec4(vec2(thit), 0.0f, 0.0f);  // (t, iteration count) for ClosestHit_Julia
-        ctx.ReportHit(float(thit.x), /*hitKind*/ 0, attr);
-    }
+        wave.ReportHit(i, float(thit.x), /*hitKind*/ 0, attr);
+    });
 }
 
 template <typename T>
@@ -606,16 +670,16 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
         }));
     // Each intersection shader below ends with its ReportHit (the debug-flag path returns right after it), as in
     // the HLSL: ReportHitEnd::Return (docs/emulator.md, "Ending an intersection shader").
-    lib.addIntersection<ProceduralPrimitiveAttributes>(
-        "Intersection_Julia", in([accuracy](ShaderContext& ctx) { Intersection_Julia<T>(ctx, accuracy); }),
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
+        "Intersection_Julia", in([accuracy](IntersectionWave& wave) { Intersection_Julia<T>(wave, accuracy); }),
         ReportHitEnd::Return);
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Julia",
         in([traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
             ClosestHit_Julia<T>(ctx, traceRay, accuracy, payload, attr);
         }));
-    lib.addIntersection<ProceduralPrimitiveAttributes>(
-        "Intersection_Pacman", in([accuracy](ShaderContext& ctx) { Intersection_Pacman<T>(ctx, accuracy); }),
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
+        "Intersection_Pacman", in([accuracy](IntersectionWave& wave) { Intersection_Pacman<T>(wave, accuracy); }),
         ReportHitEnd::Return);
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Pacman",
@@ -623,9 +687,9 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
                                          const ProceduralPrimitiveAttributes& attr) {
             ClosestHit_Pacman<T>(ctx, traceRay, accuracy, effects, payload, attr);
         }));
-    lib.addIntersection<ProceduralPrimitiveAttributes>(
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
         "Intersection_Mandelbulb",
-        in([accuracy](ShaderContext& ctx) { Intersection_Mandelbulb<T>(ctx, accuracy); }), ReportHitEnd::Return);
+        in([accuracy](IntersectionWave& wave) { Intersection_Mandelbulb<T>(wave, accuracy); }), ReportHitEnd::Return);
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Mandelbulb",
         in([traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {

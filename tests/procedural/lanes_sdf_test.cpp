@@ -122,8 +122,8 @@ RayExtent<L> laneExtent(const RayIn* in) {
     for (int i = 0; i < W; ++i) {
         setLane(e.tMin, i, in[i].tMin);
         setLane(e.tCurrent, i, in[i].tCurrent);
-        e.cullBackFacing[i] = in[i].cullBack;
-        e.cullFrontFacing[i] = in[i].cullFront;
+        e.cullBackFacing.v[i] = in[i].cullBack;
+        e.cullFrontFacing.v[i] = in[i].cullFront;
     }
     return e;
 }

@@ -1,0 +1,34 @@
+// What the intersection-shader ports need to run over a wave's lanes (emulator/intersection_wave.h): the lane type of
+// a library's scalar type, and the gathering of per-lane values (what a lane's intrinsics and resources give) into
+// lanes. The scalar parts of a port (reading a lane's record and resources, turning its hit into attributes) run
+// per lane with the scalar type, exactly as the one-ray code does; the march between them runs in lanes
+// (procedural/math/lanes.h), so each lane's result is bit for bit the one-ray result.
+#pragma once
+
+#include <array>
+
+#include "emulator/intersection_wave.h"
+#include "procedural/math/lanes.h"
+#include "procedural/math/ray.h"
+
+namespace refray::procedural {
+
+// The lane type of a wave shader whose one-ray math runs in T.
+template <typename T>
+using WaveLanes = math::Lanes<T, dxr::kMaxWaveWidth>;
+
+// f(lane's ShaderContext) for every active lane of `wave`, in lane order; an inactive lane gets the first active
+// lane's value, so that the math over every lane runs on sane values (a NaN ray would keep a march running). A lane
+// whose `f` throws (an error that stops its launch) leaves the wave (IntersectionWave::forEachLane).
+template <class F>
+auto gatherLanes(dxr::IntersectionWave& wave, F f) {
+    using V = decltype(f(wave.lane(0)));
+    std::array<V, dxr::kMaxWaveWidth> values{};
+    wave.forEachLane([&](int i, dxr::ShaderContext& ctx) { values[size_t(i)] = f(ctx); });
+    const int first = wave.active().any() ? wave.active().lowest() : 0;
+    for (int i = 0; i < dxr::kMaxWaveWidth; ++i)
+        if (!wave.isActive(i)) values[size_t(i)] = values[size_t(first)];
+    return values;
+}
+
+}  // namespace refray::procedural
