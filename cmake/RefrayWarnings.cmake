@@ -39,7 +39,9 @@ target_link_libraries(refray_warnings INTERFACE refray_sanitizers refray_compile
 # nothing refray crosses. REFRAY_NATIVE_ARCH=OFF builds for any x86-64 (tools/gpu_bundle.sh, for another machine).
 option(REFRAY_NATIVE_ARCH "Compile for the building machine's CPU (-march=native)" ON)
 add_library(refray_target_cpu INTERFACE)
-target_compile_options(refray_target_cpu INTERFACE -ffp-contract=off -Wno-psabi)
+# A target with the property REFRAY_CONTRACT_FMA (procedural/CMakeLists.txt: refray_procedural_fma) contracts instead.
+target_compile_options(refray_target_cpu INTERFACE
+                       $<IF:$<BOOL:$<TARGET_PROPERTY:REFRAY_CONTRACT_FMA>>,-ffp-contract=fast,-ffp-contract=off> -Wno-psabi)
 if(REFRAY_NATIVE_ARCH)
   include(CheckCXXCompilerFlag)
   check_cxx_compiler_flag(-march=native REFRAY_HAVE_MARCH_NATIVE)

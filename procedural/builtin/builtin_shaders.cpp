@@ -3,7 +3,9 @@
 #include <cmath>
 
 #include "core/ray_offset.h"
+#include "emulator/intersection_wave.h"
 #include "emulator/shader_api.h"
+#include "procedural/wave_shader.h"
 
 namespace refray::procedural::builtin {
 
@@ -79,20 +81,6 @@ vec3 lambert(vec3 albedo, vec3 normal, vec3 toLightUnit, bool shadowed) {
     return albedo * (0.15f + (shadowed ? 0.0f : 0.85f * cosine));
 }
 
-bool intersectSphere(vec3 o, vec3 d, float radius, float tMin, float tMax, float& tHit) {
-    const float a = glm::dot(d, d), b = glm::dot(o, d), c = glm::dot(o, o) - radius * radius;
-    const float disc = b * b - a * c;
-    if (disc < 0.0f) return false;
-    const float root = std::sqrt(disc);
-    for (float t : {(-b - root) / a, (-b + root) / a}) {
-        if (t >= tMin && t <= tMax) {
-            tHit = t;
-            return true;
-        }
-    }
-    return false;
-}
-
 vec3 primaryDirection(const SceneConstants& sc, uvec3 index, uvec3 dims) {
     const float sx = (float(index.x) + 0.5f) / float(dims.x) * 2.0f - 1.0f;
     const float sy = -((float(index.y) + 0.5f) / float(dims.y) * 2.0f - 1.0f);
@@ -134,14 +122,37 @@ std::shared_ptr<ShaderLibrary> makeShaderLibrary(SecondaryRayOrigin mode) {
         });
 
     // Analytic sphere in object space; reports t in the caller's (object = world) units.
-    lib->addIntersection<SphereAttributes>("Intersection_Sphere", [](ShaderContext& ctx) {
-        const SceneConstants sc = sceneConstants(ctx);
-        const vec3 centre = vec3(sc.sphere);
-        const float radius = sc.sphere.w;
-        const vec3 o = ctx.ObjectRayOrigin() - centre, d = ctx.ObjectRayDirection();
-        float t;
-        if (intersectSphere(o, d, radius, ctx.RayTMin(), ctx.RayTCurrent(), t))
-            ctx.ReportHit(t, 0, SphereAttributes{(o + t * d) / radius});
+    // Run over the lanes of a record group (emulator/intersection_wave.h): each lane reads its ray and the sphere,
+    // the root is found for all lanes at once, each lane reports its own hit.
+    lib->addWaveIntersection<SphereAttributes>("Intersection_Sphere", [](IntersectionWave& wave) {
+        struct LaneInput {
+            vec3 o, d;
+            float radius, tMin, tCurrent;
+        };
+        const auto in = gatherLanes(wave, [](ShaderContext& ctx) {
+            const SceneConstants sc = sceneConstants(ctx);
+            return LaneInput{ctx.ObjectRayOrigin() - vec3(sc.sphere), ctx.ObjectRayDirection(), sc.sphere.w,
+                             ctx.RayTMin(), ctx.RayTCurrent()};
+        });
+        if (wave.active().empty()) return;
+        using L = WaveLanes<float>;
+        glm::vec<3, L> o, d;
+        L radius, tMin, tCurrent, t(0.0f);
+        for (int i = 0; i < kMaxWaveWidth; ++i) {
+            const LaneInput& l = in[size_t(i)];
+            math::setLane(o, i, l.o);
+            math::setLane(d, i, l.d);
+            math::setLane(radius, i, l.radius);
+            math::setLane(tMin, i, l.tMin);
+            math::setLane(tCurrent, i, l.tCurrent);
+        }
+        const math::LaneMask<L> hit = intersectSphere(o, d, radius, tMin, tCurrent, t);
+        for (int i : wave.active()) {
+            if (!math::lane(hit, i)) continue;
+            const LaneInput& l = in[size_t(i)];
+            const float ti = math::lane(t, i);
+            wave.ReportHit(i, ti, 0, SphereAttributes{(l.o + ti * l.d) / l.radius});
+        }
     }, ReportHitEnd::Return);  // the ReportHit is its last action
 
     lib->addClosestHit<RadiancePayload, SphereAttributes>(

@@ -9,6 +9,7 @@
 
 #include "core/math.h"
 #include "emulator/state_object.h"
+#include "procedural/math/hlsl.h"
 
 namespace refray::procedural::builtin {
 
@@ -66,8 +67,26 @@ vec4 skyColor(vec3 direction);
 vec3 checkerAlbedo(vec3 position, vec3 albedo);
 // Lambert with a fixed ambient term; `shadowed` is the shadow ray's answer.
 vec3 lambert(vec3 albedo, vec3 normal, vec3 toLightUnit, bool shadowed);
-// Nearest root of |o + t d - centre| = radius within [tMin, tMax], if any.
-bool intersectSphere(vec3 origin, vec3 direction, float radius, float tMin, float tMax, float& tHit);
+// Nearest root of |o + t d - centre| = radius within [tMin, tMax], if any. Written once for a float and for a
+// wave's float lanes (procedural/math/lanes.h): per lane, bit for bit the float result.
+template <class T>
+math::LaneMask<T> intersectSphere(glm::vec<3, T> o, glm::vec<3, T> d, T radius, T tMin, T tMax, T& tHit) {
+    const T a = d.x * d.x + d.y * d.y + d.z * d.z;  // glm::dot's order
+    const T b = o.x * d.x + o.y * d.y + o.z * d.z;
+    const T c = (o.x * o.x + o.y * o.y + o.z * o.z) - radius * radius;
+    const T disc = b * b - a * c;
+    const math::LaneMask<T> real = !(disc < T(0.0f));
+    const T root = hlsl::sqrt(disc);
+    const T near = (-b - root) / a, far = (-b + root) / a;
+    const math::LaneMask<T> nearIn = real && near >= tMin && near <= tMax;
+    const math::LaneMask<T> farIn = real && !nearIn && far >= tMin && far <= tMax;
+    if constexpr (math::kIsLanes<T>) {
+        tHit = math::select(nearIn, near, math::select(farIn, far, tHit));
+    } else if (nearIn || farIn) {
+        tHit = nearIn ? near : far;  // tHit is written only for a hit
+    }
+    return nearIn || farIn;
+}
 // The primary ray direction of pixel `index` (pinhole, pixel centre).
 vec3 primaryDirection(const SceneConstants& sc, uvec3 index, uvec3 dims);
 
