@@ -24,7 +24,8 @@ void runWave(Wave& wave, std::span<const uvec3> launches, const LaunchFunction& 
         WaveLane& lane = wave.lanes[i];
         lane.failure = nullptr;
         if (!wave.fibers[i]) wave.fibers[i] = std::make_unique<Fiber>(Fiber::defaultStackBytes());
-        wave.fibers[i]->start([&launch, &lane, at = launches[i]] { launch(lane.ts, at); });
+        lane.launch = launches[i];
+        wave.fibers[i]->start([&launch, &lane] { launch(lane.ts, lane.launch); });  // two pointers: no allocation
     }
     // Each lane runs until its first TraceRay or its end; then the parked rays traverse together and their lanes
     // go on, until none is left.

@@ -27,6 +27,7 @@ struct WaveLane {
     ThreadState ts;
     Wave* wave = nullptr;
     int index = 0;
+    uvec3 launch{0u};  // the launch index the lane runs
     // The parked TraceRay: its ray and where it was called. Set by awaitTraversal, read by the packet.
     RayState* ray = nullptr;
     Site site{ShaderStage::RayGeneration, &kNoExport, 0};
