@@ -29,6 +29,9 @@ namespace refray::procedural::math {
 // The widest wave: 16 floats, one AVX-512 register (docs/emulator.md says why 16).
 inline constexpr int kMaxLanes = 16;
 
+// The lanes whose results still count (LiveLanes, below); bit i is lane i.
+inline thread_local uint32_t tLiveLanes = ~0u;
+
 namespace detail {
 // The storage of N lanes of S: a GCC vector (operators become SIMD instructions, kept in registers where they fit)
 // for the built-in arithmetic types, an array for any other scalar type (PerturbedFloat).
@@ -113,7 +116,11 @@ struct Lanes {
         if constexpr (kVector) {                                                \
             r.v = a.v op b.v;                                                   \
         } else {                                                                \
-            for (int i = 0; i < N; ++i) r.v[i] = a.v[i] op b.v[i];              \
+            r = a;                                                              \
+            for (uint32_t l = liveBits(); l; l &= l - 1) {                      \
+                const int i = std::countr_zero(l);                              \
+                r.v[i] = a.v[i] op b.v[i];                                      \
+            }                                                                   \
         }                                                                       \
         return r;                                                               \
     }                                                                           \
@@ -128,10 +135,17 @@ struct Lanes {
         if constexpr (kVector) {
             r.v = -a.v;
         } else {
-            for (int i = 0; i < N; ++i) r.v[i] = -a.v[i];
+            r = a;
+            for (uint32_t l = liveBits(); l; l &= l - 1) {
+                const int i = std::countr_zero(l);
+                r.v[i] = -a.v[i];
+            }
         }
         return r;
     }
+    // The live lanes of this width (tLiveLanes): a scalar type without SIMD instructions (PerturbedFloat) computes
+    // these only; the others keep an operand, which no live lane reads.
+    static uint32_t liveBits() { return tLiveLanes & (N >= 32 ? ~0u : (1u << N) - 1u); }
     friend Lanes operator+(const Lanes& a) { return a; }
 
 #define REFRAY_LANES_COMPARE(op)                                                                     \
@@ -140,7 +154,11 @@ struct Lanes {
         if constexpr (kVector && sizeof(S) == 4) {                                                   \
             r.v = typename LaneBools<N>::Storage(a.v op b.v) & 1u;                                   \
         } else {                                                                                     \
-            for (int i = 0; i < N; ++i) r.v[i] = a.v[i] op b.v[i];                                   \
+            r = LaneBools<N>(false);                                                                 \
+            for (uint32_t l = liveBits(); l; l &= l - 1) {                                           \
+                const int i = std::countr_zero(l);                                                   \
+                r.v[i] = a.v[i] op b.v[i];                                                           \
+            }                                                                                        \
         }                                                                                            \
         return r;                                                                                    \
     }
@@ -227,7 +245,6 @@ glm::vec<K, Lanes<S, N>, Q> select(const LaneBools<N>& m, const glm::vec<K, Lane
 // lanes only, and the others keep their operand. Sound because a march keeps each new value only in its running
 // lanes (select), so what a stopped lane computes is never read. A scope narrows the enclosing one for its
 // lifetime; for a scalar mask it does nothing. Per thread: a wave's shader runs on its worker without switching.
-inline thread_local uint32_t tLiveLanes = ~0u;
 class LiveLanes {
 public:
     explicit LiveLanes(bool) {}
@@ -338,7 +355,7 @@ struct ScalarOps<math::Lanes<S, N>> {
             r.v = typename L::Storage(Bits(x.v) & 0x7fffffffu);
             return r;
         } else {
-            return map(x, [](S a) { return ScalarOps<S>::abs(a); });
+            return mapLive(x, [](S a) { return ScalarOps<S>::abs(a); });
         }
     }
     static L floor(const L& x) {
@@ -357,7 +374,7 @@ struct ScalarOps<math::Lanes<S, N>> {
             r.v = small ? t : a;
             return r;
         } else {
-            return map(x, [](S a) { return ScalarOps<S>::floor(a); });
+            return mapLive(x, [](S a) { return ScalarOps<S>::floor(a); });
         }
     }
     static L sqrt(const L& x) {
@@ -396,11 +413,11 @@ struct ScalarOps<math::Lanes<S, N>> {
             return r;
 #endif
         }
-        return map(x, [](S a) { return ScalarOps<S>::sqrt(a); });
+        return mapLive(x, [](S a) { return ScalarOps<S>::sqrt(a); });
     }
     static L rsqrt(const L& x) {
         if constexpr (kFloat) return L(1.0f) / sqrt(x);
-        else return map(x, [](S a) { return ScalarOps<S>::rsqrt(a); });
+        else return mapLive(x, [](S a) { return ScalarOps<S>::rsqrt(a); });
     }
     static L sin(const L& x) { return mapLive(x, [](S a) { return ScalarOps<S>::sin(a); }); }
     static L cos(const L& x) { return mapLive(x, [](S a) { return ScalarOps<S>::cos(a); }); }
@@ -417,7 +434,7 @@ struct ScalarOps<math::Lanes<S, N>> {
             r.v = ((a.v <= b.v) | ((b.v != b.v) & (a.v == a.v))) ? a.v : b.v;
             return r;
         } else {
-            return map(a, b, [](S x, S y) { return ScalarOps<S>::min(x, y); });
+            return mapLive(a, b, [](S x, S y) { return ScalarOps<S>::min(x, y); });
         }
     }
     static L max(const L& a, const L& b) {
@@ -426,7 +443,7 @@ struct ScalarOps<math::Lanes<S, N>> {
             r.v = ((a.v >= b.v) | ((b.v != b.v) & (a.v == a.v))) ? a.v : b.v;
             return r;
         } else {
-            return map(a, b, [](S x, S y) { return ScalarOps<S>::max(x, y); });
+            return mapLive(a, b, [](S x, S y) { return ScalarOps<S>::max(x, y); });
         }
     }
     static L frem(const L& a, const L& b) { return mapLive(a, b, [](S x, S y) { return ScalarOps<S>::frem(x, y); }); }
@@ -439,8 +456,9 @@ struct ScalarOps<math::Lanes<S, N>> {
             for (glm::length_t k = 1; k < K; ++k) s = s + a[k] * b[k];
             return s;
         }
-        L r;
-        for (int i = 0; i < N; ++i) {
+        L r = a[0];
+        for (uint32_t l = L::liveBits(); l; l &= l - 1) {
+            const int i = std::countr_zero(l);
             glm::vec<K, S, Q> x, y;
             for (glm::length_t k = 0; k < K; ++k) {
                 x[k] = a[k].v[i];
