@@ -745,11 +745,11 @@ void InlineAmbientOcclusionCS(ShaderContext& ctx, const TraceRayArgumentSet& tra
 // The three intersection shaders (MyIntersectionShader_AnalyticPrimitive, _VolumetricPrimitive,
 // _SignedDistancePrimitive), run once over the lanes of a record group (emulator/intersection_wave.h).
 // PORT: each lane reads its own ray, record and constants, and reports its own hit, with the one-ray code in T; the
-// intersection test between them runs over the lanes at once (T's lanes, WaveLanes<T>). The lanes of a record group
+// intersection test between them runs over the lanes at once (T's lanes, WaveLanes<T>; T itself for a group of one
+// lane, withLaneType). The lanes of a record group
 // share the record, so the primitive type is the group's.
-template <typename T>
+template <typename T, typename L>
 void IntersectionShaderOf(IntersectionWave& wave, IntersectionShader shader, const Accuracy& accuracy) {
-    using L = WaveLanes<T>;
     [[maybe_unused]] PrecisionScope<L> scope;
     struct LaneInput {
         PrimitiveInstancePerFrameBuffer aabbAttribute;
@@ -779,8 +779,8 @@ void IntersectionShaderOf(IntersectionWave& wave, IntersectionShader shader, con
         math::setLane(localRay.direction, i, l.localRay.direction);
         math::setLane(extent.tMin, i, l.extent.tMin);
         math::setLane(extent.tCurrent, i, l.extent.tCurrent);
-        extent.cullBackFacing.v[i] = l.extent.cullBackFacing;
-        extent.cullFrontFacing.v[i] = l.extent.cullFrontFacing;
+        math::setLane(extent.cullBackFacing, i, bool(l.extent.cullBackFacing));
+        math::setLane(extent.cullFrontFacing, i, bool(l.extent.cullFrontFacing));
         math::setLane(elapsedTime, i, l.elapsedTime);
         math::setLane(stepScale, i, l.stepScale);
     }
@@ -860,19 +860,25 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
     lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_AnalyticPrimitive",
         in([accuracy](IntersectionWave& wave) {
-            IntersectionShaderOf<T>(wave, IntersectionShader::AnalyticPrimitive, accuracy);
+            withLaneType<T>(wave, [&]<class L>() {
+                IntersectionShaderOf<T, L>(wave, IntersectionShader::AnalyticPrimitive, accuracy);
+            });
         }),
         ReportHitEnd::Return);
     lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_VolumetricPrimitive",
         in([accuracy](IntersectionWave& wave) {
-            IntersectionShaderOf<T>(wave, IntersectionShader::VolumetricPrimitive, accuracy);
+            withLaneType<T>(wave, [&]<class L>() {
+                IntersectionShaderOf<T, L>(wave, IntersectionShader::VolumetricPrimitive, accuracy);
+            });
         }),
         ReportHitEnd::Return);
     lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
         "MyIntersectionShader_SignedDistancePrimitive",
         in([accuracy](IntersectionWave& wave) {
-            IntersectionShaderOf<T>(wave, IntersectionShader::SignedDistancePrimitive, accuracy);
+            withLaneType<T>(wave, [&]<class L>() {
+                IntersectionShaderOf<T, L>(wave, IntersectionShader::SignedDistancePrimitive, accuracy);
+            });
         }),
         ReportHitEnd::Return);
 }

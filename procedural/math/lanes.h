@@ -299,6 +299,10 @@ template <class S, int N>
 void setLane(Lanes<S, N>& x, int i, const S& value) {
     x.v[i] = value;
 }
+template <int N>
+void setLane(LaneBools<N>& m, int i, bool value) {
+    m.v[i] = value ? 1u : 0u;
+}
 template <glm::length_t K, class S, int N, glm::qualifier Q>
 void setLane(glm::vec<K, Lanes<S, N>, Q>& x, int i, const glm::vec<K, S, Q>& value) {
     for (glm::length_t k = 0; k < K; ++k) x[k].v[i] = value[k];

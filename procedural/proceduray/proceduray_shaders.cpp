@@ -414,7 +414,7 @@ void ClosestHit_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay
 
 // ---- The intersection shaders, run over the lanes of a record group (emulator/intersection_wave.h) ----------------
 // PORT: each lane reads its own ray, record and constants and reports its own hit with the one-ray code in T; the
-// march between runs over the lanes at once (WaveLanes<T>). Lanes of a record group share its record (primitive
+// march between runs over the lanes at once (WaveLanes<T>; T itself for a group of one lane, withLaneType). Lanes of a record group share its record (primitive
 // type, instance index, step scale).
 
 // What one lane of an intersection shader reads before its march.
@@ -438,9 +438,9 @@ LaneInput<T> readLane(const ShaderContext& ctx) {
     return in;
 }
 
-template <typename T>
-math::Ray<WaveLanes<T>> waveRay(const std::array<LaneInput<T>, kMaxWaveWidth>& in) {
-    math::Ray<WaveLanes<T>> ray;
+template <typename T, typename L>
+math::Ray<L> waveRay(const std::array<LaneInput<T>, kMaxWaveWidth>& in) {
+    math::Ray<L> ray;
     for (int i = 0; i < kMaxWaveWidth; ++i) {
         math::setLane(ray.origin, i, in[size_t(i)].localRay.origin);
         math::setLane(ray.direction, i, in[size_t(i)].localRay.direction);
@@ -459,22 +459,21 @@ LaneMask reportDebugHits(IntersectionWave& wave, const std::array<LaneInput<T>, 
     return marching;
 }
 
-template <typename T>
+template <typename T, typename L>
 void Intersection_Pacman(IntersectionWave& wave, const Accuracy& accuracy) {
-    using L = WaveLanes<T>;
     [[maybe_unused]] PrecisionScope<L> scope;
     const auto in = gatherLanes(wave, [](ShaderContext& ctx) { return readLane<T>(ctx); });
     const LaneMask marching = reportDebugHits(wave, in);
     if (marching.empty()) return;
     const math::LiveLanes live(marching.bits(), 0);  // duplicated and debug lanes skip libm's calls
     const LaneInput<T>& group = in[size_t(marching.lowest())];
-    const math::Ray<L> localRay = waveRay(in);
+    const math::Ray<L> localRay = waveRay<T, L>(in);
     math::RayExtent<L> extent;
     for (int i = 0; i < kMaxWaveWidth; ++i) {
         math::setLane(extent.tMin, i, in[size_t(i)].extent.tMin);
         math::setLane(extent.tCurrent, i, in[size_t(i)].extent.tCurrent);
-        extent.cullBackFacing.v[i] = in[size_t(i)].extent.cullBackFacing;
-        extent.cullFrontFacing.v[i] = in[size_t(i)].extent.cullFrontFacing;
+        math::setLane(extent.cullBackFacing, i, bool(in[size_t(i)].extent.cullBackFacing));
+        math::setLane(extent.cullFrontFacing, i, bool(in[size_t(i)].extent.cullFrontFacing));
     }
     const auto primitiveType = SignedDistancePrimitive(group.aabbCB.primitiveType);
 
@@ -530,9 +529,8 @@ void ClosestHit_Pacman(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, 
     rayPayload.color = vec4(color);
 }
 
-template <typename T>
+template <typename T, typename L>
 void Intersection_Mandelbulb(IntersectionWave& wave, const Accuracy& accuracy) {
-    using L = WaveLanes<T>;
     [[maybe_unused]] PrecisionScope<L> scope;
     const auto in = gatherLanes(wave, [](ShaderContext& ctx) { return readLane<T>(ctx); });
     const LaneMask marching = reportDebugHits(wave, in);
@@ -547,7 +545,7 @@ void Intersection_Mandelbulb(IntersectionWave& wave, const Accuracy& accuracy) {
     const int iMax = mandelbulbStepCount(
         math::mandelbulb::MandelbulbIterationCount(T(group.sceneCB.elapsedTime), int(group.aabbCB.instanceIndex)),
         accuracy);
-    const math::Ray<L> localRay = waveRay(in);
+    const math::Ray<L> localRay = waveRay<T, L>(in);
     const math::mandelbulb::MandelbulbHit<L> primitiveTest =
         math::mandelbulb::MandelbulbDistance(localRay.origin, localRay.direction, iMax, mandelbulbParams<L>(accuracy));
 
@@ -587,9 +585,8 @@ void ClosestHit_Mandelbulb(ShaderContext& ctx, const TraceRayArgumentSet& traceR
     rayPayload.color = vec4(color);
 }
 
-template <typename T>
+template <typename T, typename L>
 void Intersection_Julia(IntersectionWave& wave, const Accuracy& accuracy) {
-    using L = WaveLanes<T>;
     [[maybe_unused]] PrecisionScope<L> scope;
     const auto in = gatherLanes(wave, [](ShaderContext& ctx) { return readLane<T>(ctx); });
     const LaneMask marching = reportDebugHits(wave, in);
@@ -598,7 +595,7 @@ void Intersection_Julia(IntersectionWave& wave, const Accuracy& accuracy) {
 
     // PORT: JuliaDistance takes no time; the HLSL's cut animation is computed and then ignored (§5.5).
     // PORT: the iterations, march steps, stop precision and normal offset come from the library's Accuracy.
-    const math::Ray<L> localRay = waveRay(in);
+    const math::Ray<L> localRay = waveRay<T, L>(in);
     const math::julia::JuliaHit<L> primitiveTest =
         math::julia::JuliaDistance(localRay.origin, localRay.direction, juliaParams<L>(accuracy));
 
@@ -671,7 +668,9 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
     // Each intersection shader below ends with its ReportHit (the debug-flag path returns right after it), as in
     // the HLSL: ReportHitEnd::Return (docs/emulator.md, "Ending an intersection shader").
     lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
-        "Intersection_Julia", in([accuracy](IntersectionWave& wave) { Intersection_Julia<T>(wave, accuracy); }),
+        "Intersection_Julia", in([accuracy](IntersectionWave& wave) {
+            withLaneType<T>(wave, [&]<class L>() { Intersection_Julia<T, L>(wave, accuracy); });
+        }),
         ReportHitEnd::Return);
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Julia",
@@ -679,7 +678,9 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
             ClosestHit_Julia<T>(ctx, traceRay, accuracy, payload, attr);
         }));
     lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
-        "Intersection_Pacman", in([accuracy](IntersectionWave& wave) { Intersection_Pacman<T>(wave, accuracy); }),
+        "Intersection_Pacman", in([accuracy](IntersectionWave& wave) {
+            withLaneType<T>(wave, [&]<class L>() { Intersection_Pacman<T, L>(wave, accuracy); });
+        }),
         ReportHitEnd::Return);
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Pacman",
@@ -689,7 +690,9 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
         }));
     lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
         "Intersection_Mandelbulb",
-        in([accuracy](IntersectionWave& wave) { Intersection_Mandelbulb<T>(wave, accuracy); }), ReportHitEnd::Return);
+        in([accuracy](IntersectionWave& wave) {
+            withLaneType<T>(wave, [&]<class L>() { Intersection_Mandelbulb<T, L>(wave, accuracy); });
+        }), ReportHitEnd::Return);
     lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
         "ClosestHit_Mandelbulb",
         in([traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
