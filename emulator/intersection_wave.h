@@ -45,6 +45,22 @@ public:
         }
     }
 
+    // f() once for each active lane alone (the wave narrowed to that lane meanwhile), in lane order: for a shader
+    // whose scalar type has no SIMD instructions, one lane at a time costs less than lanes kept in step.
+    template <class F>
+    void forEachLaneAlone(F&& f) {
+        const LaneMask all = active_;
+        LaneMask left;
+        for (int i : all) {
+            active_ = LaneMask::only(i);
+            fallback_ = i;
+            f();
+            if (!active_.test(i)) left.set(i);
+        }
+        active_ = LaneMask(all.bits() & ~left.bits());
+        fallback_ = active_.any() ? active_.lowest() : 0;
+    }
+
     // ReportHit for lane `lane` (it must be active). Returns what its ReportHit returns; the lane leaves the wave when
     // the hit ends its search.
     template <class Attributes>

@@ -32,10 +32,14 @@ auto gatherLanes(dxr::IntersectionWave& wave, F f) {
 }
 
 // Calls f.template operator()<L>() with the lane type a record group's math runs in: T itself for a group of one lane
-// (nothing to keep in step, and no lanes to pay for), WaveLanes<T> otherwise. Both give each lane the same bits.
+// (nothing to keep in step, and no lanes to pay for), WaveLanes<T> otherwise. A scalar type without SIMD
+// instructions (PerturbedFloat, whose every operation is a hash and a rounding) runs each lane alone in T. All give
+// each lane the same bits.
 template <typename T, class F>
-void withLaneType(const dxr::IntersectionWave& wave, F&& f) {
-    if (wave.active().count() == 1)
+void withLaneType(dxr::IntersectionWave& wave, F&& f) {
+    if constexpr (!WaveLanes<T>::kVector)
+        wave.forEachLaneAlone([&] { f.template operator()<T>(); });
+    else if (wave.active().count() == 1)
         f.template operator()<T>();
     else
         f.template operator()<WaveLanes<T>>();
