@@ -11,7 +11,13 @@
 
 #include "core/error.h"
 
-#if defined(__SANITIZE_ADDRESS__)
+// GCC says -fsanitize=address with __SANITIZE_ADDRESS__, clang (the fuzz preset) with __has_feature.
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define REFRAY_FIBER_UNDER_ASAN 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) || defined(REFRAY_FIBER_UNDER_ASAN)
 #include <sanitizer/asan_interface.h>
 #include <sanitizer/common_interface_defs.h>
 #define REFRAY_FIBER_ASAN 1
