@@ -47,31 +47,47 @@ bool advanceLane(WaveLane& lane) {
     return true;
 }
 
-// One record group's intersection shader, run once over its lanes.
-void runIntersectionGroup(Wave& wave, LaneMask group) {
-    const ShaderExport& shader = *wave.lanes[size_t(group.lowest())].intersection.shader;
+// One call of a record group's intersection shader over `count` of its lanes: call lane k is wave lane waveLane[k].
+void runIntersectionCall(Wave& wave, const ShaderExport& shader, const std::array<int, kMaxWaveWidth>& waveLane,
+                         int count) {
     std::array<std::optional<ShaderContext>, kMaxWaveWidth> contexts;
     std::array<ShaderContext*, kMaxWaveWidth> lanes{};
     std::array<uint8_t, kMaxWaveWidth> callerSections{};
-    for (int i : group) {
-        WaveLane& lane = wave.lanes[size_t(i)];
-        callerSections[size_t(i)] = beginInvocation(lane.ts, lane.intersection);
-        lanes[size_t(i)] = &contexts[size_t(i)].emplace(lane.intersection);
+    for (int k = 0; k < count; ++k) {
+        WaveLane& lane = wave.lanes[size_t(waveLane[size_t(k)])];
+        callerSections[size_t(k)] = beginInvocation(lane.ts, lane.intersection);
+        lanes[size_t(k)] = &contexts[size_t(k)].emplace(lane.intersection);
     }
-    IntersectionWave shaderWave(lanes, group);
+    IntersectionWave shaderWave(lanes, LaneMask((1u << count) - 1u));
     std::exception_ptr escaped;
     try {
         shader.waveIntersection(shaderWave);
     } catch (...) {
         escaped = std::current_exception();  // not one lane's: it stops every lane still running the shader
     }
-    for (int i : group) {
-        WaveLane& lane = wave.lanes[size_t(i)];
-        endInvocation(lane.ts, callerSections[size_t(i)]);
-        if (shaderWave.failure(i)) lane.failure = shaderWave.failure(i);
-        else if (escaped && shaderWave.isActive(i)) lane.failure = escaped;
-        else if (lane.intersection.searchEnded || shaderWave.endedByUnwinding(i)) lane.ray->searchEnded = true;
+    for (int k = 0; k < count; ++k) {
+        WaveLane& lane = wave.lanes[size_t(waveLane[size_t(k)])];
+        endInvocation(lane.ts, callerSections[size_t(k)]);
+        if (shaderWave.failure(k)) lane.failure = shaderWave.failure(k);
+        else if (escaped && shaderWave.isActive(k)) lane.failure = escaped;
+        else if (lane.intersection.searchEnded || shaderWave.endedByUnwinding(k)) lane.ray->searchEnded = true;
     }
+}
+
+// One record group's intersection shader, run over its lanes in calls of at most the shader's waveLanesPerCall
+// lanes (the width of its SIMD math), in lane order.
+void runIntersectionGroup(Wave& wave, LaneMask group) {
+    const ShaderExport& shader = *wave.lanes[size_t(group.lowest())].intersection.shader;
+    std::array<int, kMaxWaveWidth> waveLane{};
+    int count = 0;
+    for (int i : group) {
+        waveLane[size_t(count++)] = i;
+        if (count == shader.waveLanesPerCall) {
+            runIntersectionCall(wave, shader, waveLane, count);
+            count = 0;
+        }
+    }
+    if (count > 0) runIntersectionCall(wave, shader, waveLane, count);
 }
 
 }  // namespace

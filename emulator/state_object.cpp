@@ -65,12 +65,15 @@ void ShaderLibrary::add(ShaderExport e) {
     exports_.emplace(name, std::move(e));
 }
 
-void ShaderLibrary::addWaveIntersection(std::string name, TypeTag attributes, WaveIntersectionShader fn,
-                                        ReportHitEnd end) {
+void ShaderLibrary::addWaveIntersection(std::string name, TypeTag attributes, int lanesPerCall,
+                                        WaveIntersectionShader fn, ReportHitEnd end) {
     REFRAY_CHECK(fn, "shader export '" << name << "' has no function");
+    REFRAY_CHECK(lanesPerCall >= 1 && lanesPerCall <= kMaxWaveWidth,
+                 "shader export '" << name << "' takes " << lanesPerCall << " lanes a call, outside 1.." << kMaxWaveWidth);
     ShaderExport e{std::move(name), ShaderStage::Intersection, {}, attributes, {},
                    [fn](ShaderContext& c, void*, const void*) { IntersectionWave::runAlone(fn, c); }, end};
     e.waveIntersection = std::move(fn);
+    e.waveLanesPerCall = lanesPerCall;
     add(std::move(e));
 }
 

@@ -12,6 +12,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "emulator/lane_mask.h"
 #include "emulator/root_signature.h"
 #include "emulator/types.h"
 
@@ -71,6 +72,9 @@ struct ShaderExport {
     std::vector<uint32_t> rayQueryFlags = {};
     // IS written for waves: the wave's record groups call this; `function` runs it for one lane alone.
     WaveIntersectionShader waveIntersection = {};
+    // The most lanes one waveIntersection call takes (the width of its SIMD math): a larger record group runs in
+    // parts of at most this many lanes, each part's lanes numbered from 0.
+    int waveLanesPerCall = kMaxWaveWidth;
 };
 
 // A DXIL library: named shader exports. Signatures mirror HLSL entry points:
@@ -88,11 +92,13 @@ public:
         add({std::move(name), ShaderStage::Intersection, {}, typeTag<Attributes>(), {},
              [fn = std::move(fn)](ShaderContext& c, void*, const void*) { fn(c); }, end});
     }
-    // An intersection shader written for waves (emulator/intersection_wave.h): one call computes the lanes of a record
-    // group together; each lane's ReportHit goes through IntersectionWave::ReportHit.
+    // An intersection shader written for waves (emulator/intersection_wave.h): one call computes up to
+    // `lanesPerCall` (1..kMaxWaveWidth) lanes of a record group together, numbered from 0; each lane's ReportHit goes
+    // through IntersectionWave::ReportHit.
     template <class Attributes>
-    void addWaveIntersection(std::string name, WaveIntersectionShader fn, ReportHitEnd end = ReportHitEnd::Unwind) {
-        addWaveIntersection(std::move(name), typeTag<Attributes>(), std::move(fn), end);
+    void addWaveIntersection(std::string name, int lanesPerCall, WaveIntersectionShader fn,
+                             ReportHitEnd end = ReportHitEnd::Unwind) {
+        addWaveIntersection(std::move(name), typeTag<Attributes>(), lanesPerCall, std::move(fn), end);
     }
     template <class Payload, class Attributes>
     void addAnyHit(std::string name, std::function<void(ShaderContext&, Payload&, const Attributes&)> fn) {
@@ -127,7 +133,8 @@ public:
 
 private:
     void add(ShaderExport e);
-    void addWaveIntersection(std::string name, TypeTag attributes, WaveIntersectionShader fn, ReportHitEnd end);
+    void addWaveIntersection(std::string name, TypeTag attributes, int lanesPerCall, WaveIntersectionShader fn,
+                             ReportHitEnd end);
     std::map<std::string, ShaderExport> exports_;
 };
 

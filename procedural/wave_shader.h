@@ -13,9 +13,16 @@
 
 namespace refray::procedural {
 
+// How many lanes the ports' wave math holds (ShaderLibrary::addWaveIntersection's lanesPerCall): a record group of
+// more lanes runs in calls of this many. 8 floats fill a 256-bit register. On this project's AVX-512 machine (AMD
+// Zen 4) a 512-bit instruction runs as two 256-bit halves, so 16-float lanes cost twice as much per instruction
+// and gain nothing at full occupancy, while a march runs until its slowest lane ends: the slowest of 8 rays ends
+// sooner than the slowest of 16 (docs/performance.md, "With the wave executor").
+inline constexpr int kWaveLanes = 8;
+
 // The lane type of a wave shader whose one-ray math runs in T.
 template <typename T>
-using WaveLanes = math::Lanes<T, dxr::kMaxWaveWidth>;
+using WaveLanes = math::Lanes<T, kWaveLanes>;
 
 // f(lane's ShaderContext) for every active lane of `wave`, in lane order; an inactive lane gets the first active
 // lane's value, so that the math over every lane runs on sane values (a NaN ray would keep a march running). A lane
@@ -29,6 +36,15 @@ auto gatherLanes(dxr::IntersectionWave& wave, F f) {
     for (int i = 0; i < dxr::kMaxWaveWidth; ++i)
         if (!wave.isActive(i)) values[size_t(i)] = values[size_t(first)];
     return values;
+}
+
+// The lanes of one value of every lane's input: lane i of the result is get(in[i]) (for a group of one lane, whose
+// lane type is the scalar type itself, the value of its input, which every entry holds; gatherLanes).
+template <class Result, class Input, class Get>
+Result toLanes(const std::array<Input, dxr::kMaxWaveWidth>& in, Get get) {
+    Result lanes{};
+    for (int i = 0; i < kWaveLanes; ++i) math::setLane(lanes, i, get(in[size_t(i)]));
+    return lanes;
 }
 
 // Calls f.template operator()<L>() with the lane type a record group's math runs in: T itself for a group of one lane

@@ -124,7 +124,7 @@ std::shared_ptr<ShaderLibrary> makeShaderLibrary(SecondaryRayOrigin mode) {
     // Analytic sphere in object space; reports t in the caller's (object = world) units.
     // Run over the lanes of a record group (emulator/intersection_wave.h): each lane reads its ray and the sphere,
     // the root is found for all lanes at once, each lane reports its own hit.
-    lib->addWaveIntersection<SphereAttributes>("Intersection_Sphere", [](IntersectionWave& wave) {
+    lib->addWaveIntersection<SphereAttributes>("Intersection_Sphere", kWaveLanes, [](IntersectionWave& wave) {
         struct LaneInput {
             vec3 o, d;
             float radius, tMin, tCurrent;
@@ -136,16 +136,12 @@ std::shared_ptr<ShaderLibrary> makeShaderLibrary(SecondaryRayOrigin mode) {
         });
         if (wave.active().empty()) return;
         using L = WaveLanes<float>;
-        glm::vec<3, L> o, d;
-        L radius, tMin, tCurrent, t(0.0f);
-        for (int i = 0; i < kMaxWaveWidth; ++i) {
-            const LaneInput& l = in[size_t(i)];
-            math::setLane(o, i, l.o);
-            math::setLane(d, i, l.d);
-            math::setLane(radius, i, l.radius);
-            math::setLane(tMin, i, l.tMin);
-            math::setLane(tCurrent, i, l.tCurrent);
-        }
+        const auto o = toLanes<glm::vec<3, L>>(in, [](const LaneInput& l) { return l.o; });
+        const auto d = toLanes<glm::vec<3, L>>(in, [](const LaneInput& l) { return l.d; });
+        const L radius = toLanes<L>(in, [](const LaneInput& l) { return l.radius; });
+        const L tMin = toLanes<L>(in, [](const LaneInput& l) { return l.tMin; });
+        const L tCurrent = toLanes<L>(in, [](const LaneInput& l) { return l.tCurrent; });
+        L t(0.0f);
         const math::LaneMask<L> hit = intersectSphere(o, d, radius, tMin, tCurrent, t);
         for (int i : wave.active()) {
             if (!math::lane(hit, i)) continue;

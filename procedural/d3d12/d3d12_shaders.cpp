@@ -770,20 +770,10 @@ void IntersectionShaderOf(IntersectionWave& wave, IntersectionShader shader, con
     });
     if (wave.active().empty()) return;
     const math::LiveLanes live(wave.active().bits(), 0);  // duplicated inactive lanes skip libm's calls
-    math::Ray<L> localRay;
-    math::RayExtent<L> extent;
-    L elapsedTime, stepScale;
-    for (int i = 0; i < kMaxWaveWidth; ++i) {
-        const LaneInput& l = in[size_t(i)];
-        math::setLane(localRay.origin, i, l.localRay.origin);
-        math::setLane(localRay.direction, i, l.localRay.direction);
-        math::setLane(extent.tMin, i, l.extent.tMin);
-        math::setLane(extent.tCurrent, i, l.extent.tCurrent);
-        math::setLane(extent.cullBackFacing, i, bool(l.extent.cullBackFacing));
-        math::setLane(extent.cullFrontFacing, i, bool(l.extent.cullFrontFacing));
-        math::setLane(elapsedTime, i, l.elapsedTime);
-        math::setLane(stepScale, i, l.stepScale);
-    }
+    const auto localRay = toLanes<math::Ray<L>>(in, [](const LaneInput& l) { return l.localRay; });
+    const auto extent = toLanes<math::RayExtent<L>>(in, [](const LaneInput& l) { return l.extent; });
+    const L elapsedTime = toLanes<L>(in, [](const LaneInput& l) { return l.elapsedTime; });
+    const L stepScale = toLanes<L>(in, [](const LaneInput& l) { return l.stepScale; });
     const PrimitiveHit<L> test = IntersectPrimitive<L>(shader, in[size_t(wave.active().lowest())].primitiveType, localRay,
                                                        extent, elapsedTime, stepScale, accuracy);
     wave.forEachLane([&](int i, ShaderContext& ctx) {
@@ -857,24 +847,21 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
     lib.addMiss<ShadowRayPayload>("MyMissShader_ShadowRay", MyMissShader_ShadowRay);
     // Each intersection shader's ReportHit is its last action, as in the HLSL: ReportHitEnd::Return spares the unwind
     // when a shadow ray's hit ends the search (docs/emulator.md, "Ending an intersection shader").
-    lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
-        "MyIntersectionShader_AnalyticPrimitive",
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("MyIntersectionShader_AnalyticPrimitive", kWaveLanes,
         in([accuracy](IntersectionWave& wave) {
             withLaneType<T>(wave, [&]<class L>() {
                 IntersectionShaderOf<T, L>(wave, IntersectionShader::AnalyticPrimitive, accuracy);
             });
         }),
         ReportHitEnd::Return);
-    lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
-        "MyIntersectionShader_VolumetricPrimitive",
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("MyIntersectionShader_VolumetricPrimitive", kWaveLanes,
         in([accuracy](IntersectionWave& wave) {
             withLaneType<T>(wave, [&]<class L>() {
                 IntersectionShaderOf<T, L>(wave, IntersectionShader::VolumetricPrimitive, accuracy);
             });
         }),
         ReportHitEnd::Return);
-    lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
-        "MyIntersectionShader_SignedDistancePrimitive",
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("MyIntersectionShader_SignedDistancePrimitive", kWaveLanes,
         in([accuracy](IntersectionWave& wave) {
             withLaneType<T>(wave, [&]<class L>() {
                 IntersectionShaderOf<T, L>(wave, IntersectionShader::SignedDistancePrimitive, accuracy);

@@ -79,33 +79,26 @@ AnalyticHit<T> RaySphereIntersectionTest(const Ray<T>& ray, const RayExtent<T>& 
     if (!anyLane(solved)) return r;
     tmax = select(solved, t1, tmax);
 
+    // The lanes of `mask` try root t: its normal becomes the hit's normal, and where IsAValidHit accepts it, t is
+    // the hit. Returns the accepted lanes.
+    const auto tryRoot = [&](const LaneMask<T>& mask, const T& t) {
+        const vec3<T> normal = CalculateNormalForARaySphereHit(ray, t, center);
+        r.normal = select(mask, normal, r.normal);
+        const LaneMask<T> valid = mask && IsAValidHit(ray, t, normal, extent);
+        r.hit = r.hit || valid;
+        r.thit = select(valid, t, r.thit);
+        return valid;
+    };
     const LaneMask<T> t0BeforeTMin = t0 < extent.tMin;
     const LaneMask<T> front = solved && t0BeforeTMin;
     if (anyLane(front)) {
         const LaneMask<T> t1Reached = front && !(t1 < extent.tMin);  // if (t1 < TMin) return
-        if (anyLane(t1Reached)) {
-            const vec3<T> normal = CalculateNormalForARaySphereHit(ray, t1, center);
-            r.normal = select(t1Reached, normal, r.normal);
-            const LaneMask<T> valid = t1Reached && IsAValidHit(ray, t1, normal, extent);
-            r.hit = r.hit || valid;
-            r.thit = select(valid, t1, r.thit);
-        }
+        if (anyLane(t1Reached)) tryRoot(t1Reached, t1);
     }
     const LaneMask<T> back = solved && !t0BeforeTMin;
     if (anyLane(back)) {
-        const vec3<T> normal0 = CalculateNormalForARaySphereHit(ray, t0, center);
-        r.normal = select(back, normal0, r.normal);
-        const LaneMask<T> valid0 = back && IsAValidHit(ray, t0, normal0, extent);
-        r.hit = r.hit || valid0;
-        r.thit = select(valid0, t0, r.thit);
-        const LaneMask<T> tryT1 = back && !valid0;  // a valid t0 returns
-        if (anyLane(tryT1)) {
-            const vec3<T> normal1 = CalculateNormalForARaySphereHit(ray, t1, center);
-            r.normal = select(tryT1, normal1, r.normal);
-            const LaneMask<T> valid1 = tryT1 && IsAValidHit(ray, t1, normal1, extent);
-            r.hit = r.hit || valid1;
-            r.thit = select(valid1, t1, r.thit);
-        }
+        const LaneMask<T> tryT1 = back && !tryRoot(back, t0);  // a valid t0 returns
+        if (anyLane(tryT1)) tryRoot(tryT1, t1);
     }
     return r;
 }

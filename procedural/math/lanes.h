@@ -80,6 +80,29 @@ struct LaneBools {
     LaneBools& operator|=(LaneBools b) { return *this = *this | b; }
 };
 
+// Bit i set where lane i of m is: one mask instruction for the vector widths (a horizontal OR of N lanes otherwise),
+// which anyLane, allLanes and LiveLanes run at every step of a march.
+template <int N>
+[[gnu::always_inline]] inline uint32_t laneBits(const LaneBools<N>& m) {
+#if defined(__AVX512F__)
+    if constexpr (N == 16) {
+        __m512i x;
+        std::memcpy(&x, &m.v, sizeof(x));
+        return _mm512_test_epi32_mask(x, x);
+    }
+#endif
+#if defined(__AVX2__)
+    if constexpr (N == 8) {
+        __m256i x;
+        std::memcpy(&x, &m.v, sizeof(x));
+        return uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_slli_epi32(x, 31))));
+    }
+#endif
+    uint32_t bits = 0;
+    for (int i = 0; i < N; ++i) bits |= (m.v[i] & 1u) << i;
+    return bits;
+}
+
 template <class S, int N = kMaxLanes>
 struct Lanes {
     static_assert(std::is_trivially_default_constructible_v<S>, "GLM keeps components in unions");
@@ -111,7 +134,7 @@ struct Lanes {
     }
 
 #define REFRAY_LANES_BINARY(op)                                                 \
-    friend Lanes operator op(const Lanes& a, const Lanes& b) {                  \
+    [[gnu::always_inline]] friend Lanes operator op(const Lanes& a, const Lanes& b) { \
         Lanes r;                                                                \
         if constexpr (kVector) {                                                \
             r.v = a.v op b.v;                                                   \
@@ -149,7 +172,7 @@ struct Lanes {
     friend Lanes operator+(const Lanes& a) { return a; }
 
 #define REFRAY_LANES_COMPARE(op)                                                                     \
-    friend LaneBools<N> operator op(const Lanes& a, const Lanes& b) {                                \
+    [[gnu::always_inline]] friend LaneBools<N> operator op(const Lanes& a, const Lanes& b) {         \
         LaneBools<N> r;                                                                              \
         if constexpr (kVector && sizeof(S) == 4) {                                                   \
             r.v = typename LaneBools<N>::Storage(a.v op b.v) & 1u;                                   \
@@ -198,17 +221,13 @@ constexpr LaneMask<T> allLanesSet() { return LaneMask<T>(true); }
 
 constexpr bool anyLane(bool m) { return m; }
 template <int N>
-constexpr bool anyLane(const LaneBools<N>& m) {
-    uint32_t any = 0;
-    for (int i = 0; i < N; ++i) any |= m.v[i];
-    return any != 0;
+[[gnu::always_inline]] inline bool anyLane(const LaneBools<N>& m) {
+    return laneBits(m) != 0;
 }
 constexpr bool allLanes(bool m) { return m; }
 template <int N>
-constexpr bool allLanes(const LaneBools<N>& m) {
-    uint32_t all = 1;
-    for (int i = 0; i < N; ++i) all &= m.v[i];
-    return all != 0;
+[[gnu::always_inline]] inline bool allLanes(const LaneBools<N>& m) {
+    return laneBits(m) == (N >= 32 ? ~0u : (1u << N) - 1u);
 }
 
 // m ? a : b, lane by lane; for a scalar mask, the plain conditional.
@@ -217,8 +236,10 @@ template <class T>
 T select(bool m, const T& a, const T& b) {
     return m ? a : b;
 }
+// (Always inlined, as the lanes' operators are: a march's selects are its inner loop, and a call per select spills
+// every register of it.)
 template <class S, int N>
-Lanes<S, N> select(const LaneBools<N>& m, const Lanes<S, N>& a, const Lanes<S, N>& b) {
+[[gnu::always_inline]] inline Lanes<S, N> select(const LaneBools<N>& m, const Lanes<S, N>& a, const Lanes<S, N>& b) {
     Lanes<S, N> r;
     if constexpr (Lanes<S, N>::kVector && sizeof(S) == 4) {
         r.v = m.v != 0u ? a.v : b.v;
@@ -228,13 +249,15 @@ Lanes<S, N> select(const LaneBools<N>& m, const Lanes<S, N>& a, const Lanes<S, N
     return r;
 }
 template <int N>
-LaneBools<N> select(const LaneBools<N>& m, const LaneBools<N>& a, const LaneBools<N>& b) {  // NOLINT
+[[gnu::always_inline]] inline LaneBools<N> select(const LaneBools<N>& m, const LaneBools<N>& a,  // NOLINT
+                                                  const LaneBools<N>& b) {
     return (m & a) | (!m & b);
 }
 // Vectors of lanes (GLM's vec<K, Lanes>), component by component.
 template <glm::length_t K, class S, int N, glm::qualifier Q>
-glm::vec<K, Lanes<S, N>, Q> select(const LaneBools<N>& m, const glm::vec<K, Lanes<S, N>, Q>& a,
-                                   const glm::vec<K, Lanes<S, N>, Q>& b) {
+[[gnu::always_inline]] inline glm::vec<K, Lanes<S, N>, Q> select(const LaneBools<N>& m,
+                                                                 const glm::vec<K, Lanes<S, N>, Q>& a,
+                                                                 const glm::vec<K, Lanes<S, N>, Q>& b) {
     glm::vec<K, Lanes<S, N>, Q> r;
     for (glm::length_t k = 0; k < K; ++k) r[k] = select(m, a[k], b[k]);
     return r;
@@ -250,9 +273,7 @@ public:
     explicit LiveLanes(bool) {}
     template <int N>
     explicit LiveLanes(const LaneBools<N>& m) : saved_(tLiveLanes), restore_(true) {
-        uint32_t bits = 0;
-        for (int i = 0; i < N; ++i) bits |= (m.v[i] & 1u) << i;
-        tLiveLanes = saved_ & bits;
+        tLiveLanes = saved_ & laneBits(m);
     }
     // A wave shader's active lanes (bit i: lane i), for the whole shader.
     LiveLanes(uint32_t bits, int) : saved_(tLiveLanes), restore_(true) { tLiveLanes = bits; }
@@ -318,36 +339,40 @@ template <class S, int N>
 struct ScalarOps<math::Lanes<S, N>> {
     using L = math::Lanes<S, N>;
     using Storage = typename ScalarOps<S>::Storage;
-    template <class F>
-    static L map(const L& a, F f) {
-        L r;
-        for (int i = 0; i < N; ++i) r.v[i] = f(a.v[i]);
-        return r;
-    }
-    template <class F>
-    static L map(const L& a, const L& b, F f) {
-        L r;
-        for (int i = 0; i < N; ++i) r.v[i] = f(a.v[i], b.v[i]);
-        return r;
-    }
-    // map for the live lanes only (math::LiveLanes); the others keep their operand.
-    template <class F>
-    static L mapLive(const L& a, F f) {
+    // map for the live lanes only (math::LiveLanes); the others keep their operand. Where every live lane holds the
+    // same bits in every operand (a constant such as pow(2, -n)'s base and exponent), f runs once and its result
+    // goes to all of them: the same bits each lane's own call gives.
+    template <class F, class... More>
+    static L mapLive(const L& a, F f, const More&... more) {
         L r = a;
-        for (uint32_t live = math::tLiveLanes & ((N >= 32 ? 0u : (1u << N)) - 1u); live; live &= live - 1) {
+        uint32_t live = math::tLiveLanes & ((N >= 32 ? 0u : (1u << N)) - 1u);
+        if (!live) return r;
+        const int first = std::countr_zero(live);
+        if (uniformBits(live, first, a) && (uniformBits(live, first, more) && ...)) {
+            const S value = f(a.v[first], more.v[first]...);
+            for (; live; live &= live - 1) r.v[std::countr_zero(live)] = value;
+            return r;
+        }
+        for (; live; live &= live - 1) {
             const int i = std::countr_zero(live);
-            r.v[i] = f(a.v[i]);
+            r.v[i] = f(a.v[i], more.v[i]...);
         }
         return r;
     }
-    template <class F>
-    static L mapLive(const L& a, const L& b, F f) {
-        L r = a;
-        for (uint32_t live = math::tLiveLanes & ((N >= 32 ? 0u : (1u << N)) - 1u); live; live &= live - 1) {
-            const int i = std::countr_zero(live);
-            r.v[i] = f(a.v[i], b.v[i]);
+    // Whether every lane of `live` holds lane `first`'s bits (SIMD types only: a comparison and a mask test).
+    static bool uniformBits(uint32_t live, int first, const L& x) {
+        if constexpr (math::detail::LaneStorage<S, N>::kIsVector) {
+            using Int = math::detail::LaneCompareInt<S>;
+            using Ints = typename math::detail::LaneStorage<Int, N>::type;
+            const Ints bits = Ints(x.v);
+            const Ints equal = bits == bits[first];
+            uint32_t same = 0;
+            for (int i = 0; i < N; ++i) same |= equal[i] ? (1u << i) : 0u;
+            return (same & live) == live;
+        } else {
+            (void)live, (void)first, (void)x;
+            return false;
         }
-        return r;
     }
     static constexpr bool kFloat = std::is_same_v<S, float>;
     // float lanes: the instructions a compiler can vectorise, each bit for bit libm's (glibc's fabsf, floorf, sqrtf,
@@ -381,40 +406,31 @@ struct ScalarOps<math::Lanes<S, N>> {
             return mapLive(x, [](S a) { return ScalarOps<S>::floor(a); });
         }
     }
+    // op over x in chunks of W floats held in a V register.
+    template <int W, class V, class Op>
+    static L floatChunks(const L& x, Op op) {
+        L r;
+        for (int i = 0; i < N; i += W) {
+            V p;
+            std::memcpy(&p, reinterpret_cast<const char*>(&x.v) + i * 4, sizeof(V));
+            p = op(p);
+            std::memcpy(reinterpret_cast<char*>(&r.v) + i * 4, &p, sizeof(V));
+        }
+        return r;
+    }
     static L sqrt(const L& x) {
         if constexpr (kFloat && N % 4 == 0) {
             // sqrtps: correctly rounded, as sqrtf; the widest the target has.
-            L r;
 #if defined(__AVX512F__)
-            if constexpr (N % 16 == 0) {
-                for (int i = 0; i < N; i += 16) {
-                    __m512 p;
-                    std::memcpy(&p, reinterpret_cast<const char*>(&x.v) + i * 4, 64);
-                    p = _mm512_maskz_sqrt_ps(__mmask16(0xFFFF), p);  // (the unmasked form trips -Wmaybe-uninitialized in GCC 12)
-                    std::memcpy(reinterpret_cast<char*>(&r.v) + i * 4, &p, 64);
-                }
-                return r;
-            }
+            // (the unmasked form trips -Wmaybe-uninitialized in GCC 12)
+            if constexpr (N % 16 == 0)
+                return floatChunks<16, __m512>(x, [](__m512 p) { return _mm512_maskz_sqrt_ps(__mmask16(0xFFFF), p); });
 #endif
 #if defined(__AVX__)
-            if constexpr (N % 8 == 0) {
-                for (int i = 0; i < N; i += 8) {
-                    __m256 p;
-                    std::memcpy(&p, reinterpret_cast<const char*>(&x.v) + i * 4, 32);
-                    p = _mm256_sqrt_ps(p);
-                    std::memcpy(reinterpret_cast<char*>(&r.v) + i * 4, &p, 32);
-                }
-                return r;
-            }
+            if constexpr (N % 8 == 0) return floatChunks<8, __m256>(x, [](__m256 p) { return _mm256_sqrt_ps(p); });
 #endif
 #if REFRAY_HAS_MXCSR
-            for (int i = 0; i < N; i += 4) {
-                __m128 p;
-                std::memcpy(&p, reinterpret_cast<const char*>(&x.v) + i * 4, 16);
-                p = _mm_sqrt_ps(p);
-                std::memcpy(reinterpret_cast<char*>(&r.v) + i * 4, &p, 16);
-            }
-            return r;
+            return floatChunks<4, __m128>(x, [](__m128 p) { return _mm_sqrt_ps(p); });
 #endif
         }
         return mapLive(x, [](S a) { return ScalarOps<S>::sqrt(a); });
@@ -438,7 +454,7 @@ struct ScalarOps<math::Lanes<S, N>> {
             r.v = ((a.v <= b.v) | ((b.v != b.v) & (a.v == a.v))) ? a.v : b.v;
             return r;
         } else {
-            return mapLive(a, b, [](S x, S y) { return ScalarOps<S>::min(x, y); });
+            return mapLive(a, [](S x, S y) { return ScalarOps<S>::min(x, y); }, b);
         }
     }
     static L max(const L& a, const L& b) {
@@ -447,10 +463,10 @@ struct ScalarOps<math::Lanes<S, N>> {
             r.v = ((a.v >= b.v) | ((b.v != b.v) & (a.v == a.v))) ? a.v : b.v;
             return r;
         } else {
-            return mapLive(a, b, [](S x, S y) { return ScalarOps<S>::max(x, y); });
+            return mapLive(a, [](S x, S y) { return ScalarOps<S>::max(x, y); }, b);
         }
     }
-    static L frem(const L& a, const L& b) { return mapLive(a, b, [](S x, S y) { return ScalarOps<S>::frem(x, y); }); }
+    static L frem(const L& a, const L& b) { return mapLive(a, [](S x, S y) { return ScalarOps<S>::frem(x, y); }, b); }
     // The scalar type's dot, lane by lane (its order of terms and its rounding): for float and double the plain sum
     // of products in component order, over all lanes at once.
     template <glm::length_t K, glm::qualifier Q>

@@ -61,6 +61,23 @@ struct RayExtent {
     LaneMask<T> cullFrontFacing = LaneMask<T>(false);  // RAY_FLAG_CULL_FRONT_FACING_TRIANGLES
 };
 
+// Writes lane i of a ray or an extent over lanes from one ray's (for a scalar type, lanes.h's setLane writes the
+// whole value): what a wave shader gathers from its lanes.
+template <typename L, typename T>
+    requires kIsLanes<L>
+void setLane(Ray<L>& ray, int i, const Ray<T>& value) {
+    setLane(ray.origin, i, value.origin);
+    setLane(ray.direction, i, value.direction);
+}
+template <typename L, typename T>
+    requires kIsLanes<L>
+void setLane(RayExtent<L>& extent, int i, const RayExtent<T>& value) {
+    setLane(extent.tMin, i, value.tMin);
+    setLane(extent.tCurrent, i, value.tCurrent);
+    setLane(extent.cullBackFacing, i, bool(value.cullBackFacing));
+    setLane(extent.cullFrontFacing, i, bool(value.cullFrontFacing));
+}
+
 template <typename T>
 T length_toPow2(const vec2<T>& p) { return hlsl::dot(p, p); }
 template <typename T>

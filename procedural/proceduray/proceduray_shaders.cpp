@@ -438,43 +438,42 @@ LaneInput<T> readLane(const ShaderContext& ctx) {
     return in;
 }
 
-template <typename T, typename L>
-math::Ray<L> waveRay(const std::array<LaneInput<T>, kMaxWaveWidth>& in) {
-    math::Ray<L> ray;
-    for (int i = 0; i < kMaxWaveWidth; ++i) {
-        math::setLane(ray.origin, i, in[size_t(i)].localRay.origin);
-        math::setLane(ray.direction, i, in[size_t(i)].localRay.direction);
-    }
-    return ray;
-}
-
-// `if (g_sceneCB.debugFlag) { ReportHit(0, 1, attr); return; }` for every lane; returns the lanes that go on.
+// The opening every Proceduray intersection shader shares: each lane reads its input; `if (g_sceneCB.debugFlag) {
+// ReportHit(0, 1, attr); return; }` per lane; the lanes that go on march (and only they call libm: LiveLanes).
 template <typename T>
-LaneMask reportDebugHits(IntersectionWave& wave, const std::array<LaneInput<T>, kMaxWaveWidth>& in) {
+struct ProceduralWave {
+    std::array<LaneInput<T>, kMaxWaveWidth> in;
+    LaneMask marching;
+    math::LiveLanes live;
+    // What the group's lanes share (its record and constants): the first marching lane's.
+    const LaneInput<T>& group() const { return in[size_t(marching.lowest())]; }
+    template <typename L>
+    math::Ray<L> localRay() const {
+        return toLanes<math::Ray<L>>(in, [](const LaneInput<T>& l) { return l.localRay; });
+    }
+};
+
+template <typename T>
+ProceduralWave<T> openProceduralWave(IntersectionWave& wave) {
+    const auto in = gatherLanes(wave, [](ShaderContext& ctx) { return readLane<T>(ctx); });
     LaneMask marching;
     for (int i : wave.active()) {
         if (in[size_t(i)].sceneCB.debugFlag) wave.ReportHit(i, 0.0f, 1, kInitialAttributes);
         else marching.set(i);
     }
-    return marching;
+    return {in, marching, math::LiveLanes(marching.bits(), 0)};
 }
 
 template <typename T, typename L>
 void Intersection_Pacman(IntersectionWave& wave, const Accuracy& accuracy) {
     [[maybe_unused]] PrecisionScope<L> scope;
-    const auto in = gatherLanes(wave, [](ShaderContext& ctx) { return readLane<T>(ctx); });
-    const LaneMask marching = reportDebugHits(wave, in);
+    const ProceduralWave<T> lanes = openProceduralWave<T>(wave);
+    const auto& in = lanes.in;
+    const LaneMask marching = lanes.marching;
     if (marching.empty()) return;
-    const math::LiveLanes live(marching.bits(), 0);  // duplicated and debug lanes skip libm's calls
-    const LaneInput<T>& group = in[size_t(marching.lowest())];
-    const math::Ray<L> localRay = waveRay<T, L>(in);
-    math::RayExtent<L> extent;
-    for (int i = 0; i < kMaxWaveWidth; ++i) {
-        math::setLane(extent.tMin, i, in[size_t(i)].extent.tMin);
-        math::setLane(extent.tCurrent, i, in[size_t(i)].extent.tCurrent);
-        math::setLane(extent.cullBackFacing, i, bool(in[size_t(i)].extent.cullBackFacing));
-        math::setLane(extent.cullFrontFacing, i, bool(in[size_t(i)].extent.cullFrontFacing));
-    }
+    const LaneInput<T>& group = lanes.group();
+    const math::Ray<L> localRay = lanes.template localRay<L>();
+    const auto extent = toLanes<math::RayExtent<L>>(in, [](const LaneInput<T>& l) { return l.extent; });
     const auto primitiveType = SignedDistancePrimitive(group.aabbCB.primitiveType);
 
     const L mouth = L(math::pacman::PacmanMouthInterpolant(T(group.sceneCB.elapsedTime)));
@@ -532,11 +531,11 @@ void ClosestHit_Pacman(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, 
 template <typename T, typename L>
 void Intersection_Mandelbulb(IntersectionWave& wave, const Accuracy& accuracy) {
     [[maybe_unused]] PrecisionScope<L> scope;
-    const auto in = gatherLanes(wave, [](ShaderContext& ctx) { return readLane<T>(ctx); });
-    const LaneMask marching = reportDebugHits(wave, in);
+    const ProceduralWave<T> lanes = openProceduralWave<T>(wave);
+    const auto& in = lanes.in;
+    const LaneMask marching = lanes.marching;
     if (marching.empty()) return;
-    const math::LiveLanes live(marching.bits(), 0);  // duplicated and debug lanes skip libm's calls
-    const LaneInput<T>& group = in[size_t(marching.lowest())];
+    const LaneInput<T>& group = lanes.group();
 
     // The step count animates with time and the procedural instance ordinal (not InstanceIndex()).
     // l_materialCB.stepScale is passed by the HLSL but never used, so it is not read here.
@@ -545,7 +544,7 @@ void Intersection_Mandelbulb(IntersectionWave& wave, const Accuracy& accuracy) {
     const int iMax = mandelbulbStepCount(
         math::mandelbulb::MandelbulbIterationCount(T(group.sceneCB.elapsedTime), int(group.aabbCB.instanceIndex)),
         accuracy);
-    const math::Ray<L> localRay = waveRay<T, L>(in);
+    const math::Ray<L> localRay = lanes.template localRay<L>();
     const math::mandelbulb::MandelbulbHit<L> primitiveTest =
         math::mandelbulb::MandelbulbDistance(localRay.origin, localRay.direction, iMax, mandelbulbParams<L>(accuracy));
 
@@ -588,14 +587,14 @@ void ClosestHit_Mandelbulb(ShaderContext& ctx, const TraceRayArgumentSet& traceR
 template <typename T, typename L>
 void Intersection_Julia(IntersectionWave& wave, const Accuracy& accuracy) {
     [[maybe_unused]] PrecisionScope<L> scope;
-    const auto in = gatherLanes(wave, [](ShaderContext& ctx) { return readLane<T>(ctx); });
-    const LaneMask marching = reportDebugHits(wave, in);
+    const ProceduralWave<T> lanes = openProceduralWave<T>(wave);
+    const auto& in = lanes.in;
+    const LaneMask marching = lanes.marching;
     if (marching.empty()) return;
-    const math::LiveLanes live(marching.bits(), 0);  // duplicated and debug lanes skip libm's calls
 
     // PORT: JuliaDistance takes no time; the HLSL's cut animation is computed and then ignored (§5.5).
     // PORT: the iterations, march steps, stop precision and normal offset come from the library's Accuracy.
-    const math::Ray<L> localRay = waveRay<T, L>(in);
+    const math::Ray<L> localRay = lanes.template localRay<L>();
     const math::julia::JuliaHit<L> primitiveTest =
         math::julia::JuliaDistance(localRay.origin, localRay.direction, juliaParams<L>(accuracy));
 
@@ -667,8 +666,7 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
         }));
     // Each intersection shader below ends with its ReportHit (the debug-flag path returns right after it), as in
     // the HLSL: ReportHitEnd::Return (docs/emulator.md, "Ending an intersection shader").
-    lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
-        "Intersection_Julia", in([accuracy](IntersectionWave& wave) {
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("Intersection_Julia", kWaveLanes, in([accuracy](IntersectionWave& wave) {
             withLaneType<T>(wave, [&]<class L>() { Intersection_Julia<T, L>(wave, accuracy); });
         }),
         ReportHitEnd::Return);
@@ -677,8 +675,7 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
         in([traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
             ClosestHit_Julia<T>(ctx, traceRay, accuracy, payload, attr);
         }));
-    lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
-        "Intersection_Pacman", in([accuracy](IntersectionWave& wave) {
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("Intersection_Pacman", kWaveLanes, in([accuracy](IntersectionWave& wave) {
             withLaneType<T>(wave, [&]<class L>() { Intersection_Pacman<T, L>(wave, accuracy); });
         }),
         ReportHitEnd::Return);
@@ -688,8 +685,7 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
                                          const ProceduralPrimitiveAttributes& attr) {
             ClosestHit_Pacman<T>(ctx, traceRay, accuracy, effects, payload, attr);
         }));
-    lib.addWaveIntersection<ProceduralPrimitiveAttributes>(
-        "Intersection_Mandelbulb",
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("Intersection_Mandelbulb", kWaveLanes,
         in([accuracy](IntersectionWave& wave) {
             withLaneType<T>(wave, [&]<class L>() { Intersection_Mandelbulb<T, L>(wave, accuracy); });
         }), ReportHitEnd::Return);
