@@ -457,7 +457,8 @@ template <typename T>
 ProceduralWave<T> openProceduralWave(IntersectionWave& wave) {
     const auto in = gatherLanes(wave, [](ShaderContext& ctx) { return readLane<T>(ctx); });
     LaneMask marching;
-    for (int i : wave.active()) {
+    for (int i = 0; i < kMaxWaveWidth; ++i) {
+        if (!wave.isActive(i)) continue;
         if (in[size_t(i)].sceneCB.debugFlag) wave.ReportHit(i, 0.0f, 1, kInitialAttributes);
         else marching.set(i);
     }
