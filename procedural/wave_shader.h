@@ -18,7 +18,7 @@ namespace refray::procedural {
 // more lanes runs in calls of this many. 8 floats fill a 256-bit register. On this project's AVX-512 machine (AMD
 // Zen 4) a 512-bit instruction runs as two 256-bit halves, so 16-float lanes cost twice as much per instruction
 // and gain nothing at full occupancy, while a march runs until its slowest lane ends: the slowest of 8 rays ends
-// sooner than the slowest of 16 (docs/performance.md, "With the wave executor").
+// sooner than the slowest of 16 (docs/performance.md, "Waves with 8-lane calls").
 inline constexpr int kWaveLanes = 8;
 
 // The lane type of a wave shader whose one-ray math runs in T.
@@ -56,7 +56,7 @@ Result toLanes(const std::array<Input, dxr::kMaxWaveWidth>& in, Get get) {
 // same bits.
 template <typename T, class F>
 void withLaneType(dxr::IntersectionWave& wave, F&& f) {
-    if constexpr (!WaveLanes<T>::kVector || !std::is_same_v<T, float>)
+    if constexpr (!std::is_same_v<T, float>)
         wave.forEachLaneAlone([&] { f.template operator()<T>(); });
     else if (wave.active().count() == 1)
         f.template operator()<T>();

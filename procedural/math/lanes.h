@@ -140,10 +140,7 @@ struct Lanes {
             r.v = a.v op b.v;                                                   \
         } else {                                                                \
             r = a;                                                              \
-            for (uint32_t l = liveBits(); l; l &= l - 1) {                      \
-                const int i = std::countr_zero(l);                              \
-                r.v[i] = a.v[i] op b.v[i];                                      \
-            }                                                                   \
+            forLiveLanes([&](int i) { r.v[i] = a.v[i] op b.v[i]; });            \
         }                                                                       \
         return r;                                                               \
     }                                                                           \
@@ -159,16 +156,18 @@ struct Lanes {
             r.v = -a.v;
         } else {
             r = a;
-            for (uint32_t l = liveBits(); l; l &= l - 1) {
-                const int i = std::countr_zero(l);
-                r.v[i] = -a.v[i];
-            }
+            forLiveLanes([&](int i) { r.v[i] = -a.v[i]; });
         }
         return r;
     }
     // The live lanes of this width (tLiveLanes): a scalar type without SIMD instructions (PerturbedFloat) computes
     // these only; the others keep an operand, which no live lane reads.
     static uint32_t liveBits() { return tLiveLanes & (N >= 32 ? ~0u : (1u << N) - 1u); }
+    // f(i) for each live lane i, in lane order.
+    template <class F>
+    [[gnu::always_inline]] static void forLiveLanes(F f) {
+        for (uint32_t l = liveBits(); l; l &= l - 1) f(std::countr_zero(l));
+    }
     friend Lanes operator+(const Lanes& a) { return a; }
 
 #define REFRAY_LANES_COMPARE(op)                                                                     \
@@ -178,10 +177,7 @@ struct Lanes {
             r.v = typename LaneBools<N>::Storage(a.v op b.v) & 1u;                                   \
         } else {                                                                                     \
             r = LaneBools<N>(false);                                                                 \
-            for (uint32_t l = liveBits(); l; l &= l - 1) {                                           \
-                const int i = std::countr_zero(l);                                                   \
-                r.v[i] = a.v[i] op b.v[i];                                                           \
-            }                                                                                        \
+            forLiveLanes([&](int i) { r.v[i] = a.v[i] op b.v[i]; });                                 \
         }                                                                                            \
         return r;                                                                                    \
     }
@@ -345,18 +341,15 @@ struct ScalarOps<math::Lanes<S, N>> {
     template <class F, class... More>
     static L mapLive(const L& a, F f, const More&... more) {
         L r = a;
-        uint32_t live = math::tLiveLanes & ((N >= 32 ? 0u : (1u << N)) - 1u);
+        const uint32_t live = L::liveBits();
         if (!live) return r;
         const int first = std::countr_zero(live);
         if (uniformBits(live, first, a) && (uniformBits(live, first, more) && ...)) {
             const S value = f(a.v[first], more.v[first]...);
-            for (; live; live &= live - 1) r.v[std::countr_zero(live)] = value;
+            L::forLiveLanes([&](int i) { r.v[i] = value; });
             return r;
         }
-        for (; live; live &= live - 1) {
-            const int i = std::countr_zero(live);
-            r.v[i] = f(a.v[i], more.v[i]...);
-        }
+        L::forLiveLanes([&](int i) { r.v[i] = f(a.v[i], more.v[i]...); });
         return r;
     }
     // Whether every lane of `live` holds lane `first`'s bits (SIMD types only: a comparison and a mask test).
@@ -367,7 +360,13 @@ struct ScalarOps<math::Lanes<S, N>> {
             const Ints bits = Ints(x.v);
             const Ints equal = bits == bits[first];
             uint32_t same = 0;
-            for (int i = 0; i < N; ++i) same |= equal[i] ? (1u << i) : 0u;
+            if constexpr (sizeof(S) == 4) {
+                math::LaneBools<N> m;
+                m.v = typename math::LaneBools<N>::Storage(equal) & 1u;
+                same = math::laneBits(m);
+            } else {
+                for (int i = 0; i < N; ++i) same |= equal[i] ? (1u << i) : 0u;
+            }
             return (same & live) == live;
         } else {
             (void)live, (void)first, (void)x;
@@ -477,15 +476,14 @@ struct ScalarOps<math::Lanes<S, N>> {
             return s;
         }
         L r = a[0];
-        for (uint32_t l = L::liveBits(); l; l &= l - 1) {
-            const int i = std::countr_zero(l);
+        L::forLiveLanes([&](int i) {
             glm::vec<K, S, Q> x, y;
             for (glm::length_t k = 0; k < K; ++k) {
                 x[k] = a[k].v[i];
                 y[k] = b[k].v[i];
             }
             r.v[i] = ScalarOps<S>::dot(x, y);
-        }
+        });
         return r;
     }
 };
