@@ -9,6 +9,7 @@ packages=(
   googletest libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libtinyobjloader-dev
   libssl-dev  # OpenSSL's libcrypto: SHA-256 of scene files (core/hash.cpp)
+  libsleef-dev  # SLEEF: float's sin, cos, acos, atan, exp2, log2 in the shader ports, 8 lanes a call (procedural/math/transcendentals.h)
   libboost-dev  # Boost.Math (headers): Student's t distribution of 'refray compare --statistical'
   chromium  # the compare tool's HTML report is checked in headless Chromium
   fonts-dejavu-core  # legends of index maps (refray render --aov) are drawn with DejaVu Sans

@@ -14,6 +14,8 @@
 
 #include <glm/glm.hpp>
 
+#include "procedural/math/transcendentals.h"
+
 #if defined(__SSE__) || defined(__x86_64__) || defined(_M_X64)
 #include <xmmintrin.h>
 #define REFRAY_HAS_MXCSR 1
@@ -46,8 +48,9 @@ vec<N, T, Q> map(const vec<N, T, Q>& a, const vec<N, T, Q>& b, F f) {
 
 // ---- The scalar types ------------------------------------------------------------------------
 // The operations below that a GPU computes in one instruction (DXIL's unary and binary float ops, Dot2/3/4) come
-// from ScalarOps<T>; everything else is written once over them. float and double use libm, correctly rounded where
-// D3D demands it and as accurate as libm elsewhere. A scalar type of another kind specialises ScalarOps
+// from ScalarOps<T>; everything else is written once over them. float and double are correctly rounded where D3D
+// demands it; their transcendentals are SLEEF's to 1 ulp for float (procedural/math/transcendentals.h) and libm's
+// for double. A scalar type of another kind specialises ScalarOps
 // (procedural/math/perturbed.h: float with the errors the variation model allows). A specialisation is found when a
 // template is instantiated, so it may come after this header, which an overload could not.
 template <class T>
@@ -60,12 +63,19 @@ struct ScalarOps<T> {
     static T floor(T x) { return std::floor(x); }
     static T sqrt(T x) { return std::sqrt(x); }
     static T rsqrt(T x) { return T(1) / std::sqrt(x); }
-    static T sin(T x) { return std::sin(x); }
-    static T cos(T x) { return std::cos(x); }
-    static T acos(T x) { return std::acos(x); }
-    static T atan(T x) { return std::atan(x); }
-    static T exp2(T x) { return std::exp2(x); }
-    static T log2(T x) { return std::log2(x); }
+    static T sin(T x) { return transcendental(math::Transcendental::Sin, x, [](T a) { return std::sin(a); }); }
+    static T cos(T x) { return transcendental(math::Transcendental::Cos, x, [](T a) { return std::cos(a); }); }
+    static T acos(T x) { return transcendental(math::Transcendental::Acos, x, [](T a) { return std::acos(a); }); }
+    static T atan(T x) { return transcendental(math::Transcendental::Atan, x, [](T a) { return std::atan(a); }); }
+    static T exp2(T x) { return transcendental(math::Transcendental::Exp2, x, [](T a) { return std::exp2(a); }); }
+    static T log2(T x) { return transcendental(math::Transcendental::Log2, x, [](T a) { return std::log2(a); }); }
+    // float: SLEEF's (procedural/math/transcendentals.h), the functions float lanes compute eight at a time; double:
+    // libm's.
+    template <class Libm>
+    static T transcendental(math::Transcendental f, T x, Libm libm) {
+        if constexpr (std::is_same_v<T, float>) return math::transcendental(f, x);
+        else return libm(x);
+    }
     static T min(T a, T b) { return std::fmin(a, b); }
     static T max(T a, T b) { return std::fmax(a, b); }
     static T frem(T x, T y) { return std::fmod(x, y); }

@@ -438,12 +438,44 @@ struct ScalarOps<math::Lanes<S, N>> {
         if constexpr (kFloat) return L(1.0f) / sqrt(x);
         else return mapLive(x, [](S a) { return ScalarOps<S>::rsqrt(a); });
     }
-    static L sin(const L& x) { return mapLive(x, [](S a) { return ScalarOps<S>::sin(a); }); }
-    static L cos(const L& x) { return mapLive(x, [](S a) { return ScalarOps<S>::cos(a); }); }
-    static L acos(const L& x) { return mapLive(x, [](S a) { return ScalarOps<S>::acos(a); }); }
-    static L atan(const L& x) { return mapLive(x, [](S a) { return ScalarOps<S>::atan(a); }); }
-    static L exp2(const L& x) { return mapLive(x, [](S a) { return ScalarOps<S>::exp2(a); }); }
-    static L log2(const L& x) { return mapLive(x, [](S a) { return ScalarOps<S>::log2(a); }); }
+    static L sin(const L& x) { return transcendental<math::Transcendental::Sin>(x, [](S a) { return ScalarOps<S>::sin(a); }); }
+    static L cos(const L& x) { return transcendental<math::Transcendental::Cos>(x, [](S a) { return ScalarOps<S>::cos(a); }); }
+    static L acos(const L& x) { return transcendental<math::Transcendental::Acos>(x, [](S a) { return ScalarOps<S>::acos(a); }); }
+    static L atan(const L& x) { return transcendental<math::Transcendental::Atan>(x, [](S a) { return ScalarOps<S>::atan(a); }); }
+    static L exp2(const L& x) { return transcendental<math::Transcendental::Exp2>(x, [](S a) { return ScalarOps<S>::exp2(a); }); }
+    static L log2(const L& x) { return transcendental<math::Transcendental::Log2>(x, [](S a) { return ScalarOps<S>::log2(a); }); }
+    // float lanes: eight at a time through SLEEF (procedural/math/transcendentals.h), bit for bit the scalar float's
+    // function, or once where the live lanes hold one value (mapLive); the lanes that are not live keep their
+    // operand, as mapLive leaves them. Other lane types: mapLive.
+    template <math::Transcendental F, class Scalar>
+    static L transcendental(const L& x, Scalar scalar) {
+        if constexpr (kFloat && N % 8 == 0) {
+            const uint32_t live = L::liveBits();
+            if (!live || uniformBits(live, std::countr_zero(live), x)) return mapLive(x, scalar);
+            L r;
+#if REFRAY_TRANSCENDENTALS_AVX2
+            if constexpr (N == 8) {
+                r.v = std::bit_cast<typename L::Storage>(
+                    math::detail::sleefAvx2(F, std::bit_cast<__m256>(x.v), live));
+            } else
+#endif
+            {
+                alignas(32) float in[N], out[N];
+                std::memcpy(in, &x.v, sizeof(in));
+                for (int i = 0; i < N; i += 8)
+                    if ((live >> i) & 0xFFu) math::transcendental8(F, in + i, out + i, live >> i);
+                std::memcpy(&r.v, out, sizeof(out));
+            }
+            if (live != (N >= 32 ? ~0u : (1u << N) - 1u)) {
+                Bits laneBit;
+                for (int i = 0; i < N; ++i) laneBit[i] = 1u << i;
+                r.v = (laneBit & live) != 0u ? r.v : x.v;
+            }
+            return r;
+        } else {
+            return mapLive(x, scalar);
+        }
+    }
     // glibc's fminf/fmaxf: the first operand when the two compare equal (so min(+0, -0) = +0), the other operand
     // when one is a quiet NaN, the second when both are. (Signalling NaNs, which no arithmetic makes, are not
     // quietened as libm does.)

@@ -143,7 +143,9 @@ inline float withinAbsolute(double exact, double absolute, uint64_t h) {
     return withinBound(float(exact + (absolute - 0.5 * floatUlp(exact)) * symmetricUnit(h)), exact, absolute);
 }
 
-// ---- The perturbed instructions on float values (exact float results without a context) -------------------------
+// ---- The perturbed instructions on float values (float's own results without a context) --------------------------
+// float's own: hlsl::ScalarOps<float>, so SLEEF's transcendentals (procedural/math/transcendentals.h); the exact
+// value a perturbation starts from is libm's in double.
 // x / y: 2.5 ulp for 2^-126 <= |y| <= 2^126, x / 1 = x; correctly rounded outside that range (not modelled in v1).
 inline float divide(float x, float y) {
     const Context* c = current();
@@ -175,14 +177,14 @@ inline float rsqrt(float x) {
 // exp2(+-0) = 1 exactly (the exp table of D3D11.3 §22.10.6).
 inline float exp2(float x) {
     const Context* c = current();
-    if (!c || x == 0.0f) return std::exp2(x);
+    if (!c || x == 0.0f) return hlsl::ScalarOps<float>::exp2(x);
     return withinRelative(std::exp2(double(x)), variation::kExp2Relative, c->hash(Op::Exp2, bits(x)));
 }
 
 inline float log2(float x) {
     const Context* c = current();
     const double exact = std::log2(double(x));
-    if (!c || !std::isfinite(exact)) return std::log2(x);
+    if (!c || !std::isfinite(exact)) return hlsl::ScalarOps<float>::log2(x);
     const uint64_t h = c->hash(Op::Log2, bits(x));
     if (x >= 0.5f && x <= 2.0f) return withinAbsolute(exact, variation::kLog2Absolute, h);
     return withinRelative(exact, variation::kLog2Relative, h);
@@ -198,15 +200,15 @@ float sinusoid(Op op, float x, Fn fn) {
     return std::fmin(std::fmax(r, -1.0f), 1.0f);
 }
 
-inline float sin(float x) { return sinusoid(Op::Sin, x, [](auto v) { return std::sin(v); }); }
-inline float cos(float x) { return sinusoid(Op::Cos, x, [](auto v) { return std::cos(v); }); }
+inline float sin(float x) { return sinusoid(Op::Sin, x, [](auto v) { return hlsl::ScalarOps<decltype(v)>::sin(v); }); }
+inline float cos(float x) { return sinusoid(Op::Cos, x, [](auto v) { return hlsl::ScalarOps<decltype(v)>::cos(v); }); }
 
 inline float acos(float x) {
-    return withinUlpsOf(Op::Acos, variation::kAcosUlps, x, [](auto v) { return std::acos(v); });
+    return withinUlpsOf(Op::Acos, variation::kAcosUlps, x, [](auto v) { return hlsl::ScalarOps<decltype(v)>::acos(v); });
 }
 
 inline float atan(float x) {
-    return withinUlpsOf(Op::Atan, variation::kAtanUlps, x, [](auto v) { return std::atan(v); });
+    return withinUlpsOf(Op::Atan, variation::kAtanUlps, x, [](auto v) { return hlsl::ScalarOps<decltype(v)>::atan(v); });
 }
 
 // `condition ? x : y` without a branch: the perturbation's coin flips are unpredictable by design.
