@@ -1,7 +1,11 @@
-// Tests procedural/math/fractals.h over lanes: with T = Lanes<float, 16> lane i of every result (hit flag, t,
+// Tests procedural/math/fractals.h over lanes: with T = Lanes<float, W> (W = 16 and 8) lane i of every result (hit flag, t,
 // normal, orbit trap, position, iteration count) is bit for bit the T = float result for lane i's inputs, whatever
 // the other lanes hold. Seeded inputs mix rays that hit, miss and graze, so every lane mask is exercised; some
 // groups hold a few real rays among NaN/infinite/garbage lanes. PerturbedFloat must still instantiate every function.
+#ifndef REFRAY_LANES_TEST_WIDTH
+#define REFRAY_LANES_TEST_WIDTH 16
+#endif
+
 #include "procedural/math/fractals.h"
 #include "procedural/math/perturbed.h"
 
@@ -17,7 +21,9 @@
 
 namespace refray::procedural::math {
 
-using L = Lanes<float, kMaxLanes>;
+// tests/procedural/CMakeLists.txt builds this file for 16 lanes (kMaxLanes) and for 8 (the ports').
+constexpr int kTestLanes = REFRAY_LANES_TEST_WIDTH;
+using L = Lanes<float, kTestLanes>;
 
 // ---- Workarounds for the functions outside fractals.h that do not compile for lanes yet ------------------------
 // Non-template overloads for L in this namespace, found by argument-dependent lookup when the templates are
@@ -48,7 +54,7 @@ using Bits = std::vector<std::uint32_t>;
 void put(Bits& out, float x, int) { out.push_back(std::bit_cast<std::uint32_t>(x)); }
 void put(Bits& out, const L& x, int i) { out.push_back(std::bit_cast<std::uint32_t>(lane(x, i))); }
 void put(Bits& out, bool m, int) { out.push_back(m ? 1u : 0u); }
-void put(Bits& out, const LaneBools<kMaxLanes>& m, int i) { out.push_back(lane(m, i) ? 1u : 0u); }
+void put(Bits& out, const LaneBools<kTestLanes>& m, int i) { out.push_back(lane(m, i) ? 1u : 0u); }
 template <glm::length_t K, class T>
 void put(Bits& out, const glm::vec<K, T>& v, int i) {
     for (glm::length_t k = 0; k < K; ++k) put(out, v[k], i);
@@ -65,7 +71,7 @@ struct Input {
 
 Input<L> gather(const std::vector<Input<float>>& in, size_t first) {
     Input<L> g;
-    for (int i = 0; i < kMaxLanes; ++i) {
+    for (int i = 0; i < kTestLanes; ++i) {
         const Input<float>& x = in[(first + size_t(i)) % in.size()];
         setLane(g.a, i, x.a);
         setLane(g.b, i, x.b);
@@ -89,7 +95,7 @@ Input<float> garbage(std::mt19937& rng) {
     return g;
 }
 
-// Runs `fn` on every input alone (T = float) and in groups of 16 (T = L), and compares lane i of the group's result
+// Runs `fn` on every input alone (T = float) and in groups of kTestLanes (T = L), and compares lane i of the group's result
 // with the scalar result bit for bit. `isHit` tells a hit from a scalar result; returns how many groups mix hits
 // and misses. With `withGarbage`, a second pass puts the real inputs in a few lanes only (a different pattern per
 // group) and garbage in the others, and checks the real lanes.
@@ -104,26 +110,26 @@ int checkLanes(const char* name, const std::vector<Input<float>>& inputs, Fn fn,
         hits[k] = isHit(r);
     }
     int mixedGroups = 0;
-    for (size_t first = 0; first < inputs.size(); first += kMaxLanes) {
+    for (size_t first = 0; first < inputs.size(); first += kTestLanes) {
         const auto r = fn(gather(inputs, first));
         int groupHits = 0;
-        for (int i = 0; i < kMaxLanes; ++i) {
+        for (int i = 0; i < kTestLanes; ++i) {
             const size_t k = (first + size_t(i)) % inputs.size();
             Bits got;
             flat(got, r, i);
             EXPECT_EQ(got, expected[k]) << name << ": input " << k << " in lane " << i;
             groupHits += hits[k] ? 1 : 0;
         }
-        if (groupHits > 0 && groupHits < kMaxLanes) ++mixedGroups;
+        if (groupHits > 0 && groupHits < kTestLanes) ++mixedGroups;
     }
     if (withGarbage) {
         std::mt19937 rng(977);
         size_t next = 0;
         for (int group = 0; next < inputs.size() && group < 12; ++group) {
             // A few real lanes, in a pattern that changes with the group.
-            std::vector<Input<float>> lanes(kMaxLanes);
-            std::vector<size_t> real(kMaxLanes, SIZE_MAX);
-            for (int i = 0; i < kMaxLanes; ++i) {
+            std::vector<Input<float>> lanes(kTestLanes);
+            std::vector<size_t> real(kTestLanes, SIZE_MAX);
+            for (int i = 0; i < kTestLanes; ++i) {
                 if ((i * 7 + group) % 5 == 0 && next < inputs.size()) {
                     real[size_t(i)] = next;
                     lanes[size_t(i)] = inputs[next++];
@@ -132,7 +138,7 @@ int checkLanes(const char* name, const std::vector<Input<float>>& inputs, Fn fn,
                 }
             }
             const auto r = fn(gather(lanes, 0));
-            for (int i = 0; i < kMaxLanes; ++i) {
+            for (int i = 0; i < kTestLanes; ++i) {
                 if (real[size_t(i)] == SIZE_MAX) continue;
                 Bits got;
                 flat(got, r, i);

@@ -1,6 +1,10 @@
-// The SDF, metaballs and analytic intersection tests over lanes (T = Lanes<float, 16>, one ray per lane) against the
+// The SDF, metaballs and analytic intersection tests over lanes (T = Lanes<float, W>, W = 16 and 8, one ray per lane) against the
 // scalar float code, ray by ray: lane i of every result (hit flag, t, normal, position, step count, out-parameters)
 // must be bit for bit what T = float gives for ray i, whatever the other lanes hold (procedural/math/lanes.h).
+#ifndef REFRAY_LANES_TEST_WIDTH
+#define REFRAY_LANES_TEST_WIDTH 16
+#endif
+
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -19,7 +23,7 @@
 namespace refray::procedural::math {
 namespace {
 
-constexpr int W = kMaxLanes;
+constexpr int W = REFRAY_LANES_TEST_WIDTH;  // tests/procedural/CMakeLists.txt: 16 (kMaxLanes) and 8 (the ports')
 using L = Lanes<float, W>;
 using LMask = LaneMask<L>;
 
@@ -81,7 +85,7 @@ std::vector<RayIn> makeRays(uint64_t seed, int n, float paramLo, float paramHi, 
     Rng rng{seed};
     std::vector<RayIn> rays;
     for (int i = 0; i < n; ++i) rays.push_back(makeRay(rng, i, paramLo, paramHi, targetSize));
-    // Shuffle so that every group of 16 mixes the kinds (and so hits and misses).
+    // Shuffle so that every group of W mixes the kinds (and so hits and misses).
     for (int i = n - 1; i > 0; --i) std::swap(rays[i], rays[rng.next() % uint64_t(i + 1)]);
     return rays;
 }
@@ -162,11 +166,12 @@ struct HitStats {
     void expectMixed(const char* name) const {
         EXPECT_GT(hits, 0) << name;
         EXPECT_GT(misses, 0) << name;
-        EXPECT_GE(mixedGroups * 2, groups) << name << ": too few groups mix hits and misses";
+        // A third: groups of 8 mix less often than groups of 16 (TwistedTorus: 11 of 29 groups of 8).
+        EXPECT_GE(mixedGroups * 3, groups) << name << ": too few groups mix hits and misses";
     }
 };
 
-// Runs `check(group, realLanes)` over the rays in groups of 16, then over groups where only a few lanes hold real
+// Runs `check(group, realLanes)` over the rays in groups of W, then over groups where only a few lanes hold real
 // rays and the others garbage.
 template <class Check>
 void forGroups(const std::vector<RayIn>& rays, uint64_t seed, Check check) {
@@ -175,7 +180,7 @@ void forGroups(const std::vector<RayIn>& rays, uint64_t seed, Check check) {
     for (size_t g = 0; g + W <= rays.size(); g += W) check(&rays[g], all);
 
     Rng rng{seed ^ 0xABCDEFull};
-    const std::vector<std::vector<int>> sparse = {{0}, {3, 9}, {0, 5, 11}, {15}, {1, 2, 14}};
+    const std::vector<std::vector<int>> sparse = {{0}, {3, 9 % W}, {0, 5, 11 % W}, {W - 1}, {1, 2, 14 % W}};
     for (size_t s = 0; s < sparse.size(); ++s) {
         RayIn group[W];
         for (int i = 0; i < W; ++i) group[i] = garbageRay(rng, i);

@@ -1,6 +1,10 @@
 // Lanes<float, N>'s own instructions (procedural/math/lanes.h) against libm, bit for bit: abs, floor, sqrt, min and
 // max run vectorised for float lanes and must equal fabsf, floorf, sqrtf, fminf and fmaxf in every lane, on special
 // values (signed zeros, quiet NaNs, infinities, denormals, the 2^23 boundary of floor) and on random ones.
+#ifndef REFRAY_LANES_TEST_WIDTH
+#define REFRAY_LANES_TEST_WIDTH 16
+#endif
+
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -15,7 +19,9 @@
 namespace refray::procedural {
 namespace {
 
-using L = math::Lanes<float, 16>;
+// tests/procedural/CMakeLists.txt builds this file for 16 lanes (kMaxLanes) and for 8 (the ports').
+constexpr int W = REFRAY_LANES_TEST_WIDTH;
+using L = math::Lanes<float, W>;
 
 uint32_t bitsOf(float x) { return std::bit_cast<uint32_t>(x); }
 
@@ -35,22 +41,22 @@ std::vector<float> testValues() {
         if (bits != bits) bits = std::bit_cast<float>(bitsOf(bits) | 0x00400000u);  // quiet: arithmetic makes no other
         v.push_back(bits);
     }
-    while (v.size() % 16) v.push_back(1.0f);
+    while (v.size() % W) v.push_back(1.0f);
     return v;
 }
 
 L lanesAt(const std::vector<float>& v, size_t k, size_t step = 1) {
     L a;
-    for (int i = 0; i < 16; ++i) a.v[i] = v[(k + size_t(i) * step) % v.size()];
+    for (int i = 0; i < W; ++i) a.v[i] = v[(k + size_t(i) * step) % v.size()];
     return a;
 }
 
 TEST(Lanes, UnaryInstructionsAreLibmBitForBit) {
     const std::vector<float> v = testValues();
-    for (size_t k = 0; k < v.size(); k += 16) {
+    for (size_t k = 0; k < v.size(); k += W) {
         const L a = lanesAt(v, k);
         const L fl = hlsl::floor(a), ab = hlsl::abs(a), sq = hlsl::sqrt(a);
-        for (int i = 0; i < 16; ++i) {
+        for (int i = 0; i < W; ++i) {
             const float x = a.v[i];
             if (x == x) EXPECT_EQ(bitsOf(fl.v[i]), bitsOf(std::floor(x))) << "floor(" << x << ")";
             else EXPECT_NE(fl.v[i], fl.v[i]);
@@ -63,11 +69,11 @@ TEST(Lanes, UnaryInstructionsAreLibmBitForBit) {
 
 TEST(Lanes, MinAndMaxAreGlibcFminfFmaxf) {
     const std::vector<float> v = testValues();
-    for (size_t k = 0; k < v.size(); k += 16)
+    for (size_t k = 0; k < v.size(); k += W)
         for (size_t step : {1u, 7u, 31u}) {
             const L a = lanesAt(v, k), b = lanesAt(v, k + 3, step);
             const L mn = hlsl::min(a, b), mx = hlsl::max(a, b);
-            for (int i = 0; i < 16; ++i) {
+            for (int i = 0; i < W; ++i) {
                 EXPECT_EQ(bitsOf(mn.v[i]), bitsOf(std::fmin(a.v[i], b.v[i]))) << "min(" << a.v[i] << ", " << b.v[i] << ")";
                 EXPECT_EQ(bitsOf(mx.v[i]), bitsOf(std::fmax(a.v[i], b.v[i]))) << "max(" << a.v[i] << ", " << b.v[i] << ")";
             }
@@ -80,7 +86,7 @@ TEST(Lanes, SelectAndMasksWorkLaneByLane) {
     EXPECT_TRUE(math::anyLane(low));
     EXPECT_FALSE(math::allLanes(low));
     const L s = math::select(low, a, L(-1.0f));
-    for (int i = 0; i < 16; ++i) EXPECT_EQ(s.v[i], i < 4 ? float(i) : -1.0f);
+    for (int i = 0; i < W; ++i) EXPECT_EQ(s.v[i], i < 4 ? float(i) : -1.0f);
     EXPECT_EQ(math::select(true, 2.0f, 3.0f), 2.0f);  // the scalar form is the plain conditional
     EXPECT_FALSE(math::anyLane(a > L(100.0f)));
 }
