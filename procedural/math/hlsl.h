@@ -49,7 +49,7 @@ vec<N, T, Q> map(const vec<N, T, Q>& a, const vec<N, T, Q>& b, F f) {
 // ---- The scalar types ------------------------------------------------------------------------
 // The operations below that a GPU computes in one instruction (DXIL's unary and binary float ops, Dot2/3/4) come
 // from ScalarOps<T>; everything else is written once over them. float and double are correctly rounded where D3D
-// demands it; their transcendentals are SLEEF's to 1 ulp for float (procedural/math/transcendentals.h) and libm's
+// demands it; their transcendentals are SLEEF's to 3.5 ulp for float (procedural/math/transcendentals.h) and libm's
 // for double. A scalar type of another kind specialises ScalarOps
 // (procedural/math/perturbed.h: float with the errors the variation model allows). A specialisation is found when a
 // template is instantiated, so it may come after this header, which an overload could not.

@@ -75,12 +75,15 @@ TEST_P(Discrimination, CorrectCandidatesPassAndDocumentedCatchesFail) {
 #ifdef REFRAY_FMA_BINARY
     o.fusedRefray = REFRAY_FMA_BINARY;
 #endif
+    // Whether the table records mutant `name` as caught on `golden`.
+    const auto caughtOn = [&caught](const std::string& name, const std::string& golden) {
+        const auto documented = caught.find(name);
+        return documented != caught.end() && documented->second.contains(golden);
+    };
     // Only what the test judges: every correct candidate and the mutants the table records as caught on this
     // golden (a mutant it records as passing here is rendered by the report, not by the test).
     for (const DiscriminationCandidate& c : discriminationCandidates()) {
-        const auto documented = caught.find(c.name);
-        const bool judged = c.kind == CandidateKind::Correct ||
-                            (documented != caught.end() && documented->second.contains(GetParam()));
+        const bool judged = c.kind == CandidateKind::Correct || caughtOn(c.name, GetParam());
 #if defined(__SANITIZE_ADDRESS__)
         // Perturbed renders cost ten times a nominal one, and ten times more under the sanitizers: one unseen seed.
         if (c.name.rfind("perturbed-seed-", 0) == 0 && c.name != "perturbed-seed-9") continue;
@@ -103,8 +106,7 @@ TEST_P(Discrimination, CorrectCandidatesPassAndDocumentedCatchesFail) {
                 << r.judgement.describe();
             continue;
         }
-        const auto documented = caught.find(r.candidate.name);
-        if (documented == caught.end() || !documented->second.contains(r.golden)) continue;
+        if (!caughtOn(r.candidate.name, r.golden)) continue;
         EXPECT_TRUE(outcomeAsExpected(r)) << r.golden << ": the mutant " << r.candidate.name << " ("
                                           << r.candidate.what << ") is caught in docs/golden-discrimination.md but "
                                           << outcomeName(r) << " now\n"
