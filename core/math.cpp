@@ -36,17 +36,6 @@ Matrix3x4 Matrix3x4::rotation(vec3 axis, float radians) {
     return r;
 }
 
-vec3 Matrix3x4::transformPoint(vec3 p) const {
-    return {m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + m[0][3],
-            m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + m[1][3],
-            m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + m[2][3]};
-}
-
-vec3 Matrix3x4::transformVector(vec3 v) const {
-    return {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z, m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
-            m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z};
-}
-
 bool Matrix3x4::allFinite() const {
     for (const auto& row : m)
         for (float v : row)

@@ -28,8 +28,16 @@ struct Matrix3x4 {
     // Rotation about a unit axis by `radians`, right-handed, applied to column vectors.
     static Matrix3x4 rotation(vec3 axis, float radians);
 
-    vec3 transformPoint(vec3 p) const;
-    vec3 transformVector(vec3 v) const;
+    // Inline: every candidate of every ray takes its instance's object-space ray through them.
+    vec3 transformPoint(vec3 p) const {
+        return {m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + m[0][3],
+                m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + m[1][3],
+                m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + m[2][3]};
+    }
+    vec3 transformVector(vec3 v) const {
+        return {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z, m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
+                m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z};
+    }
     bool allFinite() const;
     // Determinant of the 3x3 part, in double.
     double determinant3x3() const;

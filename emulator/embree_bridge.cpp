@@ -66,6 +66,9 @@ struct GatherContext {
     const GatherRequest* request;
     float nearestCommit = INFINITY;  // Closest: the smallest t of a triangle sure to commit
     std::exception_ptr error;  // the first exception a callback caught (style rule 9)
+    // The object-space ray of the instance met last: its primitives share it.
+    uint32_t objectRayInstance = ~0u;
+    vec3 objectRayOrigin{0.0f}, objectRayDirection{0.0f};
 };
 
 // Embree's own intervals are widened a little: the exact tests decide, Embree only culls.
@@ -119,14 +122,20 @@ bool exactCandidate(const RTCIntersectContext* context, void* geometryUserPtr, u
     const bool triangles = g.type == GeometryType::Triangles;
     if (triangles ? req.skipTriangles : req.skipProcedural) return false;
 
-    // refray's own object-space ray (TRV-8): the exact inverse, not Embree's.
+    // refray's own object-space ray (TRV-8): the exact inverse, not Embree's; once per instance met.
     const uint32_t instanceIndex = context->instID[0];
-    const BuiltInstance& inst = req.tlas->instances()[instanceIndex];
+    auto& gather = *reinterpret_cast<GatherContext*>(const_cast<RTCIntersectContext*>(context));
+    if (gather.objectRayInstance != instanceIndex) {
+        const BuiltInstance& inst = req.tlas->instances()[instanceIndex];
+        gather.objectRayInstance = instanceIndex;
+        gather.objectRayOrigin = inst.worldToObject.transformPoint(req.origin);
+        gather.objectRayDirection = inst.worldToObject.transformVector(req.direction);
+    }
     c.instanceIndex = instanceIndex;
     c.geometryIndex = user->geometryIndex;
     c.primitiveIndex = prim;
-    c.objectRayOrigin = inst.worldToObject.transformPoint(req.origin);
-    c.objectRayDirection = inst.worldToObject.transformVector(req.direction);
+    c.objectRayOrigin = gather.objectRayOrigin;
+    c.objectRayDirection = gather.objectRayDirection;
 
     if (triangles) {
         const vec3* v = &g.triangleVertices[size_t(prim) * 3];

@@ -10,6 +10,7 @@
 #include "emulator/detail/shader_invocation.h"
 #include "emulator/detail/thread_state.h"
 #include "emulator/detail/trace_ray.h"
+#include "emulator/detail/wave.h"
 #include "emulator/limits.h"
 
 namespace refray::dxr {
@@ -126,6 +127,11 @@ void ShaderContext::callShader(uint32_t index, void* parameters, TypeTag type) {
                              bit(ShaderStage::Callable))))
         stageError(inv_, "CALL-2", "CallShader() may not be called from a " + std::string(toString(inv_.stage)) + " shader");
     detail::callShader(inv_, index, parameters, type);
+}
+
+void ShaderContext::callInWave(const WaveFunction& function, const WaveCallKey& key, void* state) const {
+    requireLive("a wave call");
+    detail::awaitWaveCall(*inv_.thread, function, key, state);
 }
 
 const uint8_t* ShaderContext::rootArgument(bool local, uint32_t parameter, size_t size, TypeTag type) const {

@@ -17,6 +17,7 @@
 #include "emulator/descriptor_heap.h"
 #include "emulator/detail/invocation.h"
 #include "emulator/ray_query.h"
+#include "emulator/wave_call.h"
 
 namespace refray::dxr {
 
@@ -136,6 +137,12 @@ public:
     void CallShader(uint32_t ShaderIndex, Parameters& parameters) {
         callShader(ShaderIndex, &parameters, typeTag<Parameters>());
     }
+
+    // --- Wave calls (emulator/wave_call.h): runs `function` for this lane's `state`, grouped with the other lanes
+    // of the wave that call it with the same key; returns when the lane's outputs are in `state`. Outside a wave of
+    // several lanes (width 1, an observed or profiled dispatch, a shader that runs during a packet's traversal) it
+    // runs for this lane alone, at once.
+    void callInWave(const WaveFunction& function, const WaveCallKey& key, void* state) const;
 
     // --- Local root arguments of the executing shader's record, type-checked against its
     // local root signature (REC-5, REC-7, REC-11).

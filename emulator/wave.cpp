@@ -1,4 +1,5 @@
-// The wave executor's scheduling: lanes on fibers, parked at TraceRay, resumed after their packet's traversal.
+// The wave executor's scheduling: lanes on fibers, parked at TraceRay or a wave call, resumed after their packet's
+// traversal or their call.
 #include "emulator/detail/wave.h"
 
 #include "core/error.h"
@@ -20,6 +21,8 @@ Wave::Wave(DispatchState& ds) {
 void runWave(Wave& wave, std::span<const uvec3> launches, const LaunchFunction& launch) {
     REFRAY_ASSERT(launches.size() <= size_t(kMaxWaveWidth), "a wave of " << launches.size() << " lanes");
     wave.parked = LaneMask();
+    wave.calling = LaneMask();
+    wave.grouped = launches.size() > 1;
     for (size_t i = 0; i < launches.size(); ++i) {
         WaveLane& lane = wave.lanes[i];
         lane.failure = nullptr;
@@ -27,16 +30,37 @@ void runWave(Wave& wave, std::span<const uvec3> launches, const LaunchFunction& 
         lane.launch = launches[i];
         wave.fibers[i]->start([&launch, &lane] { launch(lane.ts, lane.launch); });  // two pointers: no allocation
     }
-    // Each lane runs until its first TraceRay or its end; then the parked rays traverse together and their lanes
-    // go on, until none is left.
+    // Each lane runs until its first TraceRay, wave call or its end; then the waiting calls run grouped and their
+    // lanes go on, or, when no lane waits on a call, the parked rays traverse together and their lanes go on, until
+    // none is left.
     for (size_t i = 0; i < launches.size(); ++i) wave.fibers[i]->resume();
-    while (wave.parked.any()) {
+    while (wave.parked.any() || wave.calling.any()) {
+        if (wave.calling.any()) {
+            const LaneMask calls = wave.calling;
+            wave.calling = LaneMask();
+            runWaveCalls(wave, calls);
+            for (int i : calls) wave.fibers[size_t(i)]->resume();
+            continue;
+        }
         const LaneMask packet = wave.parked;
         wave.parked = LaneMask();
         traversePacket(wave, packet);
         for (int i : packet) wave.fibers[size_t(i)]->resume();
     }
 }
+
+namespace {
+
+// Rethrows, on the lane's fiber, what stopped the lane while it waited.
+void rethrowFailure(WaveLane& lane) {
+    if (lane.failure) {
+        std::exception_ptr failure = std::move(lane.failure);
+        lane.failure = nullptr;
+        std::rethrow_exception(failure);
+    }
+}
+
+}  // namespace
 
 void awaitTraversal(ThreadState& ts, RayState& rs, const Site& site) {
     WaveLane* lane = ts.lane;
@@ -46,11 +70,24 @@ void awaitTraversal(ThreadState& ts, RayState& rs, const Site& site) {
     lane->wave->parked.set(lane->index);
     Fiber::yield();
     lane->ray = nullptr;
-    if (lane->failure) {
-        std::exception_ptr failure = std::move(lane->failure);
-        lane->failure = nullptr;
-        std::rethrow_exception(failure);
+    rethrowFailure(*lane);
+}
+
+void awaitWaveCall(ThreadState& ts, const WaveFunction& function, const WaveCallKey& key, void* state) {
+    WaveLane* lane = ts.lane;
+    if (!lane || !lane->wave->grouped || Fiber::current() != lane->wave->fibers[size_t(lane->index)].get()) {
+        void* const alone[] = {state};
+        function.run(std::span<void* const>(alone, 1));
+        return;
     }
+    lane->call = &function;
+    lane->callKey = key;
+    lane->callState = state;
+    lane->wave->calling.set(lane->index);
+    Fiber::yield();
+    lane->call = nullptr;
+    lane->callState = nullptr;
+    rethrowFailure(*lane);
 }
 
 }  // namespace refray::dxr::detail

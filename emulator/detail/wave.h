@@ -3,7 +3,8 @@
 // run on the lane's own fiber (emulator/fiber.h) with the lane's own ThreadState. A TraceRay parks its lane
 // (awaitTraversal); when every lane of the wave is parked or done, the rays of the parked lanes traverse together as
 // a packet (packet_traversal.cpp), whose intersection shaders run once per record for the lanes that reached it
-// (record grouping); then each lane resumes with its ray's closest-hit or miss shader. Internal to the emulator.
+// (record grouping); then each lane resumes with its ray's closest-hit or miss shader. A wave call parks its lane too;
+// the calls of the waiting lanes run grouped by key (wave_call.cpp). Internal to the emulator.
 #pragma once
 
 #include <array>
@@ -17,6 +18,7 @@
 #include "emulator/detail/thread_state.h"
 #include "emulator/fiber.h"
 #include "emulator/lane_mask.h"
+#include "emulator/wave_call.h"
 
 namespace refray::dxr::detail {
 
@@ -39,6 +41,10 @@ struct WaveLane {
     HitInfo box;
     RecordView record;
     Invocation intersection;
+    // The wave call the lane waits on (awaitWaveCall): its function, key and the lane's state.
+    const WaveFunction* call = nullptr;
+    WaveCallKey callKey;
+    void* callState = nullptr;
 };
 
 // A worker thread's wave: its lanes and their fibers, kept from wave to wave.
@@ -49,7 +55,9 @@ struct Wave {
 
     std::array<WaveLane, kMaxWaveWidth> lanes;
     std::array<std::unique_ptr<Fiber>, kMaxWaveWidth> fibers;
-    LaneMask parked;  // lanes whose TraceRay waits for the packet
+    LaneMask parked;   // lanes whose TraceRay waits for the packet
+    LaneMask calling;  // lanes waiting on a wave call
+    bool grouped = false;  // more than one lane: a wave call parks its lane
 };
 
 // Runs one launch on a lane's ThreadState (the dispatcher's launch: the ray generation or compute shader).
@@ -62,6 +70,15 @@ void runWave(Wave& wave, std::span<const uvec3> launches, const LaunchFunction& 
 // runs in a packet with the other lanes' rays; returns when the ray's search is over. Rethrows what stopped the
 // lane's launch meanwhile.
 void awaitTraversal(ThreadState& ts, RayState& rs, const Site& site);
+
+// A wave call (emulator/wave_call.h) of the lane that `ts` belongs to: parks the lane until the wave runs the calls
+// of its waiting lanes (runWaveCalls); runs it at once for a lane alone or off its lane's fiber. Rethrows what
+// stopped the lane meanwhile.
+void awaitWaveCall(ThreadState& ts, const WaveFunction& function, const WaveCallKey& key, void* state);
+
+// wave_call.cpp: the waiting calls of `lanes`, grouped by function and key, each group in calls of at most its
+// function's lanesPerCall lanes, in lane order.
+void runWaveCalls(Wave& wave, LaneMask lanes);
 
 // packet_traversal.cpp: the traversal of the rays of `lanes` (parked TraceRays).
 void traversePacket(Wave& wave, LaneMask lanes);

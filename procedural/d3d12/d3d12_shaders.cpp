@@ -4,6 +4,8 @@
 #include "procedural/d3d12/d3d12_shaders.h"
 
 #include <cstring>
+#include <span>
+#include <type_traits>
 
 #include "emulator/intersection_wave.h"
 #include "emulator/shader_api.h"
@@ -320,6 +322,76 @@ PrimitiveHit<T> IntersectPrimitive(IntersectionShader shader, uint32_t primitive
     return {};
 }
 
+// Inline ray tracing's IntersectPrimitive, run once over the lanes of a wave that intersect a procedural candidate
+// of the same kind (dxr::ShaderContext::callInWave, emulator/wave_call.h), as the TraceRay version's intersection
+// shaders run over a record group: the shader, primitive type and Accuracy are the call's key; each lane's ray,
+// extent, time and step scale are its own. A call of one lane runs in float, more in WaveLanes<float> (the lanes no
+// ray fills hold the first lane's values): each lane's hit is bit for bit the one-lane result. double and
+// PerturbedFloat run alone, for withLaneType's reasons.
+struct PrimitiveCall {
+    IntersectionShader shader = IntersectionShader::AnalyticPrimitive;
+    uint32_t primitiveType = 0;
+    const Accuracy* accuracy = nullptr;
+    math::Ray<float> localRay;
+    math::RayExtent<float> extent;
+    float elapsedTime = 0.0f, stepScale = 1.0f;
+    PrimitiveHit<float> result;
+};
+
+void runPrimitiveCalls(std::span<void* const> lanes) {
+    const auto call = [&lanes](size_t i) -> PrimitiveCall& { return *static_cast<PrimitiveCall*>(lanes[i]); };
+    const PrimitiveCall& first = call(0);
+    if (lanes.size() == 1) {
+        [[maybe_unused]] PrecisionScope<float> scope;
+        call(0).result = IntersectPrimitive<float>(first.shader, first.primitiveType, first.localRay, first.extent,
+                                                   first.elapsedTime, first.stepScale, *first.accuracy);
+        return;
+    }
+    using L = WaveLanes<float>;
+    [[maybe_unused]] PrecisionScope<L> scope;
+    const math::LiveLanes live(uint32_t(dxr::LaneMask::first(int(lanes.size())).bits()), 0);
+    math::Ray<L> localRay;
+    math::RayExtent<L> extent;
+    L elapsedTime, stepScale;
+    for (int i = 0; i < kWaveLanes; ++i) {
+        const PrimitiveCall& c = size_t(i) < lanes.size() ? call(size_t(i)) : first;
+        math::setLane(localRay, i, c.localRay);
+        math::setLane(extent, i, c.extent);
+        math::setLane(elapsedTime, i, c.elapsedTime);
+        math::setLane(stepScale, i, c.stepScale);
+    }
+    const PrimitiveHit<L> hit = IntersectPrimitive<L>(first.shader, first.primitiveType, localRay, extent, elapsedTime,
+                                                      stepScale, *first.accuracy);
+    for (size_t i = 0; i < lanes.size(); ++i) {
+        PrimitiveHit<float>& r = call(i).result;
+        r.hit = math::lane(hit.hit, int(i));
+        r.thit = math::lane(hit.thit, int(i));
+        r.normal = math::lane(hit.normal, int(i));
+    }
+}
+
+inline constexpr dxr::WaveFunction kPrimitiveCalls{runPrimitiveCalls, kWaveLanes};
+
+template <typename T>
+PrimitiveHit<T> IntersectPrimitiveInWave(const ShaderContext& ctx, IntersectionShader shader, uint32_t primitiveType,
+                                         const math::Ray<T>& localRay, const math::RayExtent<T>& extent,
+                                         T elapsedTime, T stepScale, const Accuracy& accuracy) {
+    if constexpr (!std::is_same_v<T, float>) {
+        return IntersectPrimitive<T>(shader, primitiveType, localRay, extent, elapsedTime, stepScale, accuracy);
+    } else {
+        PrimitiveCall call;
+        call.shader = shader;
+        call.primitiveType = primitiveType;
+        call.accuracy = &accuracy;
+        call.localRay = localRay;
+        call.extent = extent;
+        call.elapsedTime = elapsedTime;
+        call.stepScale = stepScale;
+        ctx.callInWave(kPrimitiveCalls, {&accuracy, (uint64_t(shader) << 32) | primitiveType}, &call);
+        return call.result;
+    }
+}
+
 // TraceRay wrappers: both stop at MAX_RAY_RECURSION_DEPTH (black / "not in shadow"); TMin 0, TMax 10000.
 // The RayDesc and the payload are the GPU interface: the ray is rounded to float on the way in.
 // PORT: the HLSL passes the constants TraceRayParameters::InstanceMask, TraceRayParameters::HitGroup::Offset[rayType],
@@ -454,8 +526,8 @@ bool IntersectCandidateProceduralPrimitive(const ShaderContext& ctx, const RayQu
         variant == InlineVariant::NoRangeCheck
             ? CurrentExtent<T>(-rayTMax, rayTMax, q.RayFlags())  // MUTANT: the whole line, not [RayTMin, CommittedRayT]
             : CurrentExtent<T>(q.RayTMin(), committedRayT(q, rayTMax, variant), q.RayFlags());
-    const PrimitiveHit<T> test = IntersectPrimitive<T>(shader, primitive.primitiveType, localRay, extent, elapsedTime,
-                                                       T(primitive.stepScale), accuracy);
+    const PrimitiveHit<T> test = IntersectPrimitiveInWave<T>(ctx, shader, primitive.primitiveType, localRay, extent,
+                                                             elapsedTime, T(primitive.stepScale), accuracy);
     if (!test.hit) return false;
     thit = test.thit;
     normal = NormalToWorld(q.CandidateObjectToWorld3x4(), aabbAttribute, test.normal);

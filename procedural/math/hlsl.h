@@ -162,8 +162,15 @@ template <Scalar T>
 T exp(T x) { return hlsl::exp2(x * kLog2e<T>); }
 // pow(x, y) = exp2(y * log2(x)): pow(0, y>0) = 0, pow(0, 0) = NaN, pow(x<0, y) = NaN.
 // A literal exponent of exactly 2 compiles to x*x instead; ports write x*x there.
+// Lane types compute it once where every live lane holds one base and one exponent (ScalarOps::powOnce).
 template <Scalar T>
-T pow(T x, T y) { return hlsl::exp2(y * hlsl::log2(x)); }
+T pow(T x, T y) {
+    if constexpr (requires(T& r) { ScalarOps<T>::powOnce(x, y, r); }) {
+        T r;
+        if (ScalarOps<T>::powOnce(x, y, r)) return r;
+    }
+    return hlsl::exp2(y * hlsl::log2(x));
+}
 
 // ---- atan2 as DXC lowers it ------------------------------------------------------------------
 // r = atan(y/x), then: x<0 && y>=0 -> r+pi; x<0 && y<0 -> r-pi; x==0 && y<0 -> -pi/2;

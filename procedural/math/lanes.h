@@ -352,6 +352,16 @@ struct ScalarOps<math::Lanes<S, N>> {
         L::forLiveLanes([&](int i) { r.v[i] = f(a.v[i], more.v[i]...); });
         return r;
     }
+    // pow where every live lane holds one base and one exponent (the fractal pyramid's pow(2, -n)): r gets the one
+    // result, the bits of each lane's exp2(y * log2(x)), and true. False, with r untouched, otherwise.
+    static bool powOnce(const L& x, const L& y, L& r) {
+        const uint32_t live = L::liveBits();
+        if (!live) return false;
+        const int first = std::countr_zero(live);
+        if (!uniformBits(live, first, x) || !uniformBits(live, first, y)) return false;
+        r = L(hlsl::pow(x.v[first], y.v[first]));
+        return true;
+    }
     // Whether every lane of `live` holds lane `first`'s bits (SIMD types only: a comparison and a mask test).
     static bool uniformBits(uint32_t live, int first, const L& x) {
         if constexpr (math::detail::LaneStorage<S, N>::kIsVector) {
@@ -445,13 +455,14 @@ struct ScalarOps<math::Lanes<S, N>> {
     static L exp2(const L& x) { return transcendental<math::Transcendental::Exp2>(x, [](S a) { return ScalarOps<S>::exp2(a); }); }
     static L log2(const L& x) { return transcendental<math::Transcendental::Log2>(x, [](S a) { return ScalarOps<S>::log2(a); }); }
     // float lanes: eight at a time through SLEEF (procedural/math/transcendentals.h), bit for bit the scalar float's
-    // function, or once where the live lanes hold one value (mapLive); the lanes that are not live keep their
-    // operand, as mapLive leaves them. Other lane types: mapLive.
+    // function; the lanes that are not live keep their operand, as mapLive leaves them. Eight lanes in one AVX2 call
+    // cost what one float does, so they go straight to it; wider lanes, and a target without AVX2, compute live
+    // lanes that hold one value once (mapLive). Other lane types: mapLive.
     template <math::Transcendental F, class Scalar>
     static L transcendental(const L& x, Scalar scalar) {
         if constexpr (kFloat && N % 8 == 0) {
             const uint32_t live = L::liveBits();
-            if (!live || uniformBits(live, std::countr_zero(live), x)) return mapLive(x, scalar);
+            if (!live) return x;
             L r;
 #if REFRAY_TRANSCENDENTALS_AVX2
             if constexpr (N == 8) {
@@ -460,6 +471,7 @@ struct ScalarOps<math::Lanes<S, N>> {
             } else
 #endif
             {
+                if (uniformBits(live, std::countr_zero(live), x)) return mapLive(x, scalar);
                 alignas(32) float in[N], out[N];
                 std::memcpy(in, &x.v, sizeof(in));
                 for (int i = 0; i < N; i += 8)
