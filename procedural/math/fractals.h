@@ -8,6 +8,8 @@
 // scalar T the masks are bools and every select picks what the HLSL's branch picks: the scalar results are unchanged.
 #pragma once
 
+#include <array>
+#include <bit>
 #include <cstdint>
 
 #include "procedural/math/analytic.h"
@@ -252,22 +254,23 @@ vec3<T> calcNormal(const vec3<T>& pos, const vec4<T>& c = kc<T>(), int iMax = kI
                              offset);
 }
 
-// March in q-space between the cut planes y = deltaT and y = -1.1 inside the sphere of radius
-// 1.2: up to 1024 steps of min(d, 0.2) from tmin, stopping when d < kPrecis or t > tmax; then a
-// secant step when lt > 9.9999997e-5 and the last d < 0. Returns (t, n) when t < tmax (running
-// out of steps counts as a hit, H15), (-1, n) when t >= tmax, and (-2, 0) when a plane or the
-// sphere rules it out. IEEE comparisons decide every branch (rd.y = 0, H10).
-// PORT: the step limit 1024 and the stop test's kPrecis are parameters (maxSteps, precis: the stepsFactor and
-// thresholdFactor knobs); tmin starts at kPrecis and the secant gate stays 9.9999997e-5 whatever precis is.
+// raycast's bounds: [tmin, tmax] of the march between the cut planes y = deltaT and y = -1.1 inside the sphere of
+// radius 1.2, and the lanes that a plane or the sphere rules out (the HLSL's three `return (-2, 0)`).
+// PORT: the three returns are per lane: `ruledOut` collects the lanes that return there; they take (-2, 0) at the
+// end and stay out of the march. Each if/else on a lane's value is a select.
 template <typename T>
-vec2<T> raycast(const vec3<T>& ro, const vec3<T>& rd, const vec4<T>& c = kc<T>(), T deltaT = T(0),
-                int iMax = kIterations, int maxSteps = kMarchSteps, T precis = kPrecis<T>) {
-    T tmax = T(7000);
+struct RaycastBounds {
     T tmin = kPrecis<T>;
-
-    // PORT: the three `return (-2, 0)` are per lane: `ruledOut` collects the lanes that return there; they take
-    // (-2, 0) at the end and stay out of the march. Each if/else on a lane's value is a select.
+    T tmax = T(7000);
     LaneMask<T> ruledOut = LaneMask<T>(false);
+};
+
+template <typename T>
+RaycastBounds<T> raycastBounds(const vec3<T>& ro, const vec3<T>& rd, T deltaT) {
+    RaycastBounds<T> b;
+    T& tmin = b.tmin;
+    T& tmax = b.tmax;
+    LaneMask<T>& ruledOut = b.ruledOut;
 
     const T upperPlane = deltaT;
     const T tpS = (upperPlane - ro.y) / rd.y;
@@ -278,7 +281,7 @@ vec2<T> raycast(const vec3<T>& ro, const vec3<T>& rd, const vec4<T>& c = kc<T>()
     tmax = select(tpSAhead && !isCamAboveUpper, hlsl::min(tmax, tpS), tmax);
     // else { if (isCamAboveUpper) return (-2, 0); }
     ruledOut = ruledOut || (!tpSAhead && isCamAboveUpper);
-    if (allLanes(ruledOut)) return vec2<T>(T(-2), T(0));
+    if (allLanes(ruledOut)) return b;
 
     const T lowerPlane = T(-1.1f);
     const T tpF = (lowerPlane - ro.y) / rd.y;
@@ -289,38 +292,163 @@ vec2<T> raycast(const vec3<T>& ro, const vec3<T>& rd, const vec4<T>& c = kc<T>()
     tmax = select(tpFAhead && !isCamBellowLower, hlsl::min(tmax, tpF), tmax);
     // else { if (isCamBellowLower) return (-2, 0); }
     ruledOut = ruledOut || (!tpFAhead && isCamBellowLower);
-    if (allLanes(ruledOut)) return vec2<T>(T(-2), T(0));
+    if (allLanes(ruledOut)) return b;
 
     const vec2<T> bv = iSphere(ro, rd, T(1.2f));
     ruledOut = ruledOut || (bv.y < T(0));  // if (bv.y < 0) return (-2, 0);
-    if (allLanes(ruledOut)) return vec2<T>(T(-2), T(0));
+    if (allLanes(ruledOut)) return b;
     tmin = hlsl::max(tmin, bv.x);
     tmax = hlsl::min(tmax, bv.y);
+    return b;
+}
 
-    vec2<T> res(T(-1), T(-1));
-    T t = tmin;
+// What raycast's march carries from step to step: t, the last step's t and distance (lt, lh) and jdist's (d, n).
+template <typename T>
+struct RaycastMarch {
+    vec2<T> res = vec2<T>(T(-1), T(-1));
+    T t = T(0);
     T lt = T(0);
     T lh = T(0);
-    // PORT: res is assigned before the first break, lt, lh and t between the two: a lane that breaks keeps what the
-    // HLSL has at its break. jdist leaves out the lanes that no longer march.
-    LaneMask<T> running = !ruledOut;
-    for (int i = 0; i < maxSteps && anyLane(running); i++) {
-        const LiveLanes live(running);
-        res = select(running, jdist(ro + (rd * t), c, iMax, running), res);
-        running = running && !(res.x < precis);  // if (res.x < precis) break;
-        lt = select(running, t, lt);
-        lh = select(running, res.x, lh);
-        t = select(running, t + hlsl::min(res.x, T(0.2)), t);  // t += min(res.x, 0.2);
-        running = running && !(t > tmax);                      // if (t > tmax) break;
-    }
-    const LaneMask<T> secant = (lt > T(9.9999997e-05f)) && (res.x < T(0));
+};
+
+// One step of raycast's march for the `running` lanes, which it clears for the lanes that stop.
+// PORT: res is assigned before the first break, lt, lh and t between the two: a lane that breaks keeps what the
+// HLSL has at its break. jdist leaves out the lanes that no longer march.
+template <typename T>
+void raycastStep(const vec3<T>& ro, const vec3<T>& rd, const vec4<T>& c, int iMax, T precis, T tmax,
+                 RaycastMarch<T>& m, LaneMask<T>& running) {
+    const LiveLanes live(running);
+    m.res = select(running, jdist(ro + (rd * m.t), c, iMax, running), m.res);
+    running = running && !(m.res.x < precis);  // if (res.x < precis) break;
+    m.lt = select(running, m.t, m.lt);
+    m.lh = select(running, m.res.x, m.lh);
+    m.t = select(running, m.t + hlsl::min(m.res.x, T(0.2)), m.t);  // t += min(res.x, 0.2);
+    running = running && !(m.t > tmax);                              // if (t > tmax) break;
+}
+
+// raycast's end: a secant step when lt > 9.9999997e-5 and the last d < 0; (t, n) when t < tmax, else (-1, n);
+// (-2, 0) for the lanes ruled out.
+template <typename T>
+vec2<T> raycastResult(const RaycastBounds<T>& b, RaycastMarch<T> m) {
+    const LaneMask<T> secant = (m.lt > T(9.9999997e-05f)) && (m.res.x < T(0));
     if (anyLane(secant)) {
-        t = select(secant, lt - ((lh * (t - lt)) / (res.x - lh)), t);
+        m.t = select(secant, m.lt - ((m.lh * (m.t - m.lt)) / (m.res.x - m.lh)), m.t);
     }
     // if (t < tmax) s = t; else s = -1;
-    const T s = select(t < tmax, t, T(-1));
-    res.x = s;
-    return select(ruledOut, vec2<T>(T(-2), T(0)), res);
+    const T s = select(m.t < b.tmax, m.t, T(-1));
+    m.res.x = s;
+    return select(b.ruledOut, vec2<T>(T(-2), T(0)), m.res);
+}
+
+// March in q-space between the cut planes y = deltaT and y = -1.1 inside the sphere of radius
+// 1.2: up to 1024 steps of min(d, 0.2) from tmin, stopping when d < kPrecis or t > tmax; then a
+// secant step when lt > 9.9999997e-5 and the last d < 0. Returns (t, n) when t < tmax (running
+// out of steps counts as a hit, H15), (-1, n) when t >= tmax, and (-2, 0) when a plane or the
+// sphere rules it out. IEEE comparisons decide every branch (rd.y = 0, H10).
+// PORT: the step limit 1024 and the stop test's kPrecis are parameters (maxSteps, precis: the stepsFactor and
+// thresholdFactor knobs); tmin starts at kPrecis and the secant gate stays 9.9999997e-5 whatever precis is.
+// PORT: the HLSL's one function is raycastBounds, the loop of raycastStep and raycastResult, so that
+// raycastQueue runs the same steps for a queue of rays.
+template <typename T>
+vec2<T> raycast(const vec3<T>& ro, const vec3<T>& rd, const vec4<T>& c = kc<T>(), T deltaT = T(0),
+                int iMax = kIterations, int maxSteps = kMarchSteps, T precis = kPrecis<T>) {
+    const RaycastBounds<T> b = raycastBounds(ro, rd, deltaT);
+    if (allLanes(b.ruledOut)) return vec2<T>(T(-2), T(0));
+
+    RaycastMarch<T> m;
+    m.t = b.tmin;
+    LaneMask<T> running = !b.ruledOut;
+    for (int i = 0; i < maxSteps && anyLane(running); i++) raycastStep(ro, rd, c, iMax, precis, b.tmax, m, running);
+    return raycastResult(b, m);
+}
+
+// The most rays raycastQueue takes: a wave's (16).
+inline constexpr int kMaxRaycastQueue = 16;
+
+// Lane i of a march over lanes, and its writing.
+template <class L, class S = typename L::Scalar>
+RaycastMarch<S> marchLane(const RaycastMarch<L>& m, int i) {
+    RaycastMarch<S> r;
+    r.res = lane(m.res, i);
+    r.t = lane(m.t, i);
+    r.lt = lane(m.lt, i);
+    r.lh = lane(m.lh, i);
+    return r;
+}
+template <class L, class S>
+void setMarchLane(RaycastMarch<L>& m, int i, const RaycastMarch<S>& value) {
+    setLane(m.res, i, value.res);
+    setLane(m.t, i, value.t);
+    setLane(m.lt, i, value.lt);
+    setLane(m.lh, i, value.lh);
+}
+
+// raycast for `count` (at most kMaxRaycastQueue) rays ro[k], rd[k] in S over the lanes of L = Lanes<S, N>,
+// refilled: a lane whose ray stops marching takes the next ray of the queue at once, so the lanes keep marching
+// until the queue is empty, rather than each group of N until its slowest ray ends. Each ray takes the steps raycast
+// takes for it alone (raycastStep in its own lane; a lane's result never depends on its neighbours, lanes.h), so
+// out[k] is bit for bit raycast(ro[k], rd[k], ...) in S. c, deltaT, iMax, maxSteps and precis are every ray's.
+// PORT: not in the HLSL; a GPU would run its rays' raycast in one wave, each lane until its own ray ends.
+template <class L, class S = typename L::Scalar>
+void raycastQueue(const vec3<S>* ro, const vec3<S>* rd, int count, vec2<S>* out, const vec4<L>& c = kc<L>(),
+                  S deltaT = S(0), int iMax = kIterations, int maxSteps = kMarchSteps, S precis = kPrecis<S>) {
+    constexpr int N = L::kCount;
+    std::array<RaycastBounds<S>, kMaxRaycastQueue> bounds{};
+    std::array<RaycastMarch<S>, kMaxRaycastQueue> march{};
+    for (int k = 0; k < count; ++k) {
+        bounds[size_t(k)] = raycastBounds(ro[k], rd[k], deltaT);
+        march[size_t(k)].t = bounds[size_t(k)].tmin;  // where a ray that never marches stays
+    }
+    vec3<L> roL(L(S(0))), rdL(L(S(0)));
+    L tmaxL(S(0));
+    RaycastMarch<L> m;
+    LaneMask<L> running(false);
+    std::array<int, size_t(N)> ray{};  // the ray each lane marches
+    std::array<int, size_t(N)> steps{};
+    int next = 0;
+    // Puts the next ray that marches into lane j (a ray ruled out, or with no steps, keeps its start); or, when the
+    // queue is empty, leaves the lane out.
+    const auto load = [&](int j) {
+        while (next < count && (bounds[size_t(next)].ruledOut || maxSteps <= 0)) ++next;
+        if (next == count) {
+            setLane(running, j, false);
+            return;
+        }
+        const int k = next++;
+        ray[size_t(j)] = k;
+        steps[size_t(j)] = 0;
+        setLane(roL, j, ro[k]);
+        setLane(rdL, j, rd[k]);
+        setLane(tmaxL, j, bounds[size_t(k)].tmax);
+        setMarchLane(m, j, march[size_t(k)]);
+        setLane(running, j, true);
+    };
+    for (int j = 0; j < N; ++j) load(j);
+    if (!anyLane(running)) {
+        for (int k = 0; k < count; ++k) out[k] = raycastResult(bounds[size_t(k)], march[size_t(k)]);
+        return;
+    }
+    // The lanes with no ray hold the first marching lane's inputs, so that their math stays sane.
+    const int first = std::countr_zero(laneBits(running));
+    for (int j = 0; j < N; ++j)
+        if (!lane(running, j)) {
+            setLane(roL, j, lane(roL, first));
+            setLane(rdL, j, lane(rdL, first));
+            setLane(tmaxL, j, lane(tmaxL, first));
+            setMarchLane(m, j, marchLane(m, first));
+        }
+    const LiveLanes queueLanes(laneBits(LaneMask<L>(true)), 0);  // the queue's lanes, whatever encloses it
+    while (anyLane(running)) {
+        const LaneMask<L> stepped = running;
+        raycastStep(roL, rdL, c, iMax, L(precis), tmaxL, m, running);
+        for (int j = 0; j < N; ++j) {
+            if (!lane(stepped, j)) continue;
+            if (lane(running, j) && ++steps[size_t(j)] < maxSteps) continue;
+            march[size_t(ray[size_t(j)])] = marchLane(m, j);  // the ray stopped, or took its last step
+            load(j);
+        }
+    }
+    for (int k = 0; k < count; ++k) out[k] = raycastResult(bounds[size_t(k)], march[size_t(k)]);
 }
 
 // The constants JuliaDistance passes to raycast and calcNormal; the defaults are the HLSL's.
@@ -363,6 +491,46 @@ JuliaHit<T> JuliaDistance(vec3<T> ro, const vec3<T>& rd, const JuliaParams<T>& p
         result.hit = cond;
     }
     return result;
+}
+
+// JuliaDistance for `count` (at most kMaxRaycastQueue) rays ro[k], rd[k] in S over the lanes of L = Lanes<S, N>:
+// the march in raycastQueue, then calcNormal over the lanes for the rays that hit, N at a time. out[k] is bit for bit
+// JuliaDistance(ro[k], rd[k], params) in S.
+// PORT: not in the HLSL: the lanes' JuliaDistance, with a queue of rays instead of one ray per lane.
+template <class L, class S = typename L::Scalar>
+void JuliaDistanceQueue(const vec3<S>* roLocal, const vec3<S>* rd, int count, JuliaHit<S>* out,
+                        const JuliaParams<S>& params = {}) {
+    constexpr int N = L::kCount;
+    std::array<vec3<S>, kMaxRaycastQueue> ro{};
+    std::array<vec2<S>, kMaxRaycastQueue> tn{};
+    for (int k = 0; k < count; ++k) {
+        ro[size_t(k)] = roLocal[k] * S(0.4);
+        ro[size_t(k)].y += S(-1);
+    }
+    raycastQueue<L>(ro.data(), rd, count, tn.data(), kc<L>(), S(0), params.iterations, params.marchSteps,
+                    params.precis);
+    std::array<int, kMaxRaycastQueue> hits{};
+    int hitCount = 0;
+    for (int k = 0; k < count; ++k) {
+        out[k] = JuliaHit<S>();
+        if (!(tn[size_t(k)].x >= S(0))) continue;  // if (cond)
+        out[k].resT = tn[size_t(k)];
+        out[k].hit = true;
+        hits[size_t(hitCount++)] = k;
+    }
+    for (int first = 0; first < hitCount; first += N) {
+        const int lanes = std::min(N, hitCount - first);
+        vec3<L> pos;
+        LaneMask<L> cond(false);
+        for (int j = 0; j < N; ++j) {
+            const int k = hits[size_t(first + std::min(j, lanes - 1))];  // lanes past the rays copy the last one
+            setLane(pos, j, ro[size_t(k)] + (tn[size_t(k)].x * rd[k]));
+            setLane(cond, j, j < lanes);
+        }
+        const LiveLanes batch(laneBits(cond), 0);
+        const vec3<L> normal = calcNormal(pos, kc<L>(), params.iterations, L(params.normalOffset), cond);
+        for (int j = 0; j < lanes; ++j) out[hits[size_t(first + j)]].normal = lane(normal, j);
+    }
 }
 
 }  // namespace julia

@@ -595,17 +595,34 @@ void Intersection_Julia(IntersectionWave& wave, const Accuracy& accuracy) {
 
     // PORT: JuliaDistance takes no time; the HLSL's cut animation is computed and then ignored (§5.5).
     // PORT: the iterations, march steps, stop precision and normal offset come from the library's Accuracy.
-    const math::Ray<L> localRay = lanes.template localRay<L>();
-    const math::julia::JuliaHit<L> primitiveTest =
-        math::julia::JuliaDistance(localRay.origin, localRay.direction, juliaParams<L>(accuracy));
+    // PORT: over lanes, the marching lanes' rays go through JuliaDistanceQueue (up to a whole wave of them: the
+    // shader takes kMaxWaveWidth lanes a call), whose lanes take the next ray as soon as theirs ends.
+    std::array<math::julia::JuliaHit<T>, kMaxWaveWidth> primitiveTest{};
+    if constexpr (math::kIsLanes<L>) {
+        std::array<tvec3<T>, kMaxWaveWidth> ro{}, rd{};
+        std::array<math::julia::JuliaHit<T>, kMaxWaveWidth> queued{};
+        int count = 0;
+        for (int i : marching) {
+            ro[size_t(count)] = in[size_t(i)].localRay.origin;
+            rd[size_t(count++)] = in[size_t(i)].localRay.direction;
+        }
+        math::julia::JuliaDistanceQueue<L>(ro.data(), rd.data(), count, queued.data(), juliaParams<T>(accuracy));
+        count = 0;
+        for (int i : marching) primitiveTest[size_t(i)] = queued[size_t(count++)];
+    } else {
+        const LaneInput<T>& ray = lanes.group();  // a group of one lane
+        primitiveTest[size_t(marching.lowest())] =
+            math::julia::JuliaDistance(ray.localRay.origin, ray.localRay.direction, juliaParams<T>(accuracy));
+    }
 
     // H1: thit.x is in q-space units (0.4 x normalised local units).
     wave.forEachLane([&](int i, ShaderContext& ctx) {
         if (!marching.test(i)) return;
-        const tvec2<T> thit = math::lane(primitiveTest.resT, i);
-        if (!(math::lane(primitiveTest.hit, i) && thit.x < T(in[size_t(i)].extent.tCurrent))) return;
+        const math::julia::JuliaHit<T>& test = primitiveTest[size_t(i)];
+        const tvec2<T> thit = test.resT;
+        if (!(test.hit && thit.x < T(in[size_t(i)].extent.tCurrent))) return;
         ProceduralPrimitiveAttributes attr = kInitialAttributes;
-        attr.normal = vec3(NormalToWorld(ctx, math::lane(primitiveTest.normal, i)));
+        attr.normal = vec3(NormalToWorld(ctx, test.normal));
         attr.color = vec4(vec2(thit), 0.0f, 0.0f);  // (t, iteration count) for ClosestHit_Julia
         wave.ReportHit(i, float(thit.x), /*hitKind*/ 0, attr);
     });
@@ -667,7 +684,8 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
         }));
     // Each intersection shader below ends with its ReportHit (the debug-flag path returns right after it), as in
     // the HLSL: ReportHitEnd::Return (docs/emulator.md, "Ending an intersection shader").
-    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("Intersection_Julia", kWaveLanes, in([accuracy](IntersectionWave& wave) {
+    // Julia: a whole wave's lanes a call, for JuliaDistanceQueue's refilled lanes.
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("Intersection_Julia", kMaxWaveWidth, in([accuracy](IntersectionWave& wave) {
             withLaneType<T>(wave, [&]<class L>() { Intersection_Julia<T, L>(wave, accuracy); });
         }),
         ReportHitEnd::Return);

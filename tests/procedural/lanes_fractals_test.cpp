@@ -349,6 +349,71 @@ TEST(LanesFractals, JuliaRaycastJdistAndNormalMatchScalarPerLane) {
     checkLanes("julia::calcNormal", pts, normal, flatAny, kNoHit);
 }
 
+TEST(LanesFractals, JuliaQueuesGiveEachRayItsScalarResult) {
+    // raycastQueue and JuliaDistanceQueue refill their lanes from a queue of up to 16 rays: every ray's result is
+    // bit for bit the one-ray result, for every queue length, with rays ruled out by the cut planes or the sphere
+    // (raysAtBall's spread puts some outside), rays that run out of march steps, and queues shorter than the lanes.
+    std::vector<Input<float>> rays = raysAtBall(33, 160, glm::vec3(0, -0.5f, 0), 1.3f);
+    const std::vector<Input<float>> local = juliaRays(34, 96);
+    int ruledOut = 0, hits = 0, queues = 0;
+    for (const int maxSteps : {julia::kMarchSteps, 24, 0}) {
+        size_t first = 0;
+        for (int count = 1; first < rays.size(); count = count % julia::kMaxRaycastQueue + 1) {  // queues of 1..16
+            const int n = int(std::min<size_t>(size_t(count), rays.size() - first));
+            std::vector<glm::vec3> ro(static_cast<size_t>(n)), rd(static_cast<size_t>(n));
+            std::vector<glm::vec2> got(static_cast<size_t>(n));
+            const float deltaT = float(first % 3) * 0.25f - 0.25f;
+            for (int k = 0; k < n; ++k) {
+                ro[size_t(k)] = rays[first + size_t(k)].a;
+                rd[size_t(k)] = rays[first + size_t(k)].b;
+            }
+            julia::raycastQueue<L>(ro.data(), rd.data(), n, got.data(), julia::kc<L>(), deltaT, julia::kIterations,
+                                   maxSteps);
+            ++queues;
+            for (int k = 0; k < n; ++k) {
+                const glm::vec2 want = julia::raycast(ro[size_t(k)], rd[size_t(k)], julia::kc<float>(), deltaT,
+                                                      julia::kIterations, maxSteps);
+                Bits a, b;
+                put(a, got[size_t(k)], 0);
+                put(b, want, 0);
+                EXPECT_EQ(a, b) << "raycastQueue: ray " << first + size_t(k) << " of a queue of " << n
+                                << ", maxSteps " << maxSteps;
+                ruledOut += want.x == -2.0f ? 1 : 0;
+                hits += want.x >= 0.0f ? 1 : 0;
+            }
+            first += size_t(n);
+        }
+    }
+    EXPECT_GT(ruledOut, 0);
+    EXPECT_GT(hits, 0);
+    for (const int marchSteps : {julia::kMarchSteps, 24}) {
+        julia::JuliaParams<float> params;
+        params.marchSteps = marchSteps;
+        for (size_t first = 0; first < local.size(); first += julia::kMaxRaycastQueue) {
+            const int n = int(std::min<size_t>(julia::kMaxRaycastQueue, local.size() - first));
+            std::vector<glm::vec3> ro(static_cast<size_t>(n)), rd(static_cast<size_t>(n));
+            std::vector<julia::JuliaHit<float>> got(static_cast<size_t>(n));
+            for (int k = 0; k < n; ++k) {
+                ro[size_t(k)] = local[first + size_t(k)].a;
+                rd[size_t(k)] = local[first + size_t(k)].b;
+            }
+            julia::JuliaDistanceQueue<L>(ro.data(), rd.data(), n, got.data(), params);
+            for (int k = 0; k < n; ++k) {
+                const julia::JuliaHit<float> want = julia::JuliaDistance(ro[size_t(k)], rd[size_t(k)], params);
+                Bits a, b;
+                put(a, got[size_t(k)].hit, 0);
+                put(a, got[size_t(k)].normal, 0);
+                put(a, got[size_t(k)].resT, 0);
+                put(b, want.hit, 0);
+                put(b, want.normal, 0);
+                put(b, want.resT, 0);
+                EXPECT_EQ(a, b) << "JuliaDistanceQueue: ray " << first + size_t(k) << ", marchSteps " << marchSteps;
+            }
+        }
+    }
+    EXPECT_GT(queues, 20);
+}
+
 // ---- Pac-man ------------------------------------------------------------------------------------------------------
 TEST(LanesFractals, PacmanSdfAndHitColorMatchScalarPerLane) {
     std::vector<Input<float>> pts = positions(41, 480, 0.8f, 0.5f);
