@@ -114,8 +114,8 @@ void boundsCallback(const RTCBoundsFunctionArguments* args) {
 }
 
 // refray's exact test of one primitive Embree reports: the candidate, or nothing if the ray misses it.
-bool exactCandidate(const RTCIntersectContext* context, void* geometryUserPtr, uint32_t prim, const GatherRequest& req,
-                    Candidate& c) {
+bool exactCandidate(GatherContext& gather, void* geometryUserPtr, uint32_t prim, Candidate& c) {
+    const GatherRequest& req = *gather.request;
     const auto* user = static_cast<const UserGeometry*>(geometryUserPtr);
     const BuiltGeometry& g = *user->geometry;
     if (!g.active[prim]) return false;
@@ -123,8 +123,7 @@ bool exactCandidate(const RTCIntersectContext* context, void* geometryUserPtr, u
     if (triangles ? req.skipTriangles : req.skipProcedural) return false;
 
     // refray's own object-space ray (TRV-8): the exact inverse, not Embree's; once per instance met.
-    const uint32_t instanceIndex = context->instID[0];
-    auto& gather = *reinterpret_cast<GatherContext*>(const_cast<RTCIntersectContext*>(context));
+    const uint32_t instanceIndex = gather.embree.instID[0];
     if (gather.objectRayInstance != instanceIndex) {
         const BuiltInstance& inst = req.tlas->instances()[instanceIndex];
         gather.objectRayInstance = instanceIndex;
@@ -157,7 +156,7 @@ bool exactCandidate(const RTCIntersectContext* context, void* geometryUserPtr, u
 void gatherPrimitive(const RTCIntersectFunctionNArguments* args, GatherContext& ctx) {
     const GatherRequest& req = *ctx.request;
     Candidate c;
-    if (!exactCandidate(args->context, args->geometryUserPtr, args->primID, req, c)) return;
+    if (!exactCandidate(ctx, args->geometryUserPtr, args->primID, c)) return;
     if (req.mode == GatherMode::Closest) {
         if (c.key > ctx.nearestCommit) return;  // the ordered loop would skip it (TRV-2)
         if (!c.procedural && req.tMin < c.t && c.t < req.tMax && req.commitsSurely(req.user, c)) {
@@ -190,7 +189,7 @@ void occludedCallback(const RTCOccludedFunctionNArguments* args) {
     try {
         const GatherRequest& req = *ctx->request;
         Candidate c;
-        if (exactCandidate(args->context, args->geometryUserPtr, args->primID, req, c) && req.onCandidate(req.user, c))
+        if (exactCandidate(*ctx, args->geometryUserPtr, args->primID, c) && req.onCandidate(req.user, c))
             RTCRayN_tfar(args->ray, args->N, 0) = -INFINITY;
     } catch (...) {
         ctx->error = std::current_exception();

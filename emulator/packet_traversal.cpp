@@ -58,7 +58,7 @@ void runIntersectionCall(Wave& wave, const ShaderExport& shader, const std::arra
         callerSections[size_t(k)] = beginInvocation(lane.ts, lane.intersection);
         lanes[size_t(k)] = &contexts[size_t(k)].emplace(lane.intersection);
     }
-    IntersectionWave shaderWave(lanes, LaneMask((1u << count) - 1u));
+    IntersectionWave shaderWave(lanes, LaneMask::first(count));
     std::exception_ptr escaped;
     try {
         shader.waveIntersection(shaderWave);

@@ -424,13 +424,9 @@ void raycastQueue(const vec3<S>* ro, const vec3<S>* rd, int count, vec2<S>* out,
         setLane(running, j, true);
     };
     for (int j = 0; j < N; ++j) load(j);
-    if (!anyLane(running)) {
-        for (int k = 0; k < count; ++k) out[k] = raycastResult(bounds[size_t(k)], march[size_t(k)]);
-        return;
-    }
     // The lanes with no ray hold the first marching lane's inputs, so that their math stays sane.
-    const int first = std::countr_zero(laneBits(running));
-    for (int j = 0; j < N; ++j)
+    const int first = std::countr_zero(laneBits(running));  // 32 when no ray marches: nothing below runs
+    for (int j = 0; j < N && first < N; ++j)
         if (!lane(running, j)) {
             setLane(roL, j, lane(roL, first));
             setLane(rdL, j, lane(rdL, first));

@@ -28,6 +28,9 @@ namespace refray::procedural::math {
 
 // The widest wave: 16 floats, one AVX-512 register (docs/emulator.md says why 16).
 inline constexpr int kMaxLanes = 16;
+// The bits of all N lanes (bit i: lane i).
+template <int N>
+inline constexpr uint32_t kLaneBits = N >= 32 ? ~0u : (1u << N) - 1u;
 
 // The lanes whose results still count (LiveLanes, below); bit i is lane i.
 inline thread_local uint32_t tLiveLanes = ~0u;
@@ -162,7 +165,7 @@ struct Lanes {
     }
     // The live lanes of this width (tLiveLanes): a scalar type without SIMD instructions (PerturbedFloat) computes
     // these only; the others keep an operand, which no live lane reads.
-    static uint32_t liveBits() { return tLiveLanes & (N >= 32 ? ~0u : (1u << N) - 1u); }
+    static uint32_t liveBits() { return tLiveLanes & kLaneBits<N>; }
     // f(i) for each live lane i, in lane order.
     template <class F>
     [[gnu::always_inline]] static void forLiveLanes(F f) {
@@ -223,7 +226,7 @@ template <int N>
 constexpr bool allLanes(bool m) { return m; }
 template <int N>
 [[gnu::always_inline]] inline bool allLanes(const LaneBools<N>& m) {
-    return laneBits(m) == (N >= 32 ? ~0u : (1u << N) - 1u);
+    return laneBits(m) == kLaneBits<N>;
 }
 
 // m ? a : b, lane by lane; for a scalar mask, the plain conditional.
@@ -340,27 +343,41 @@ struct ScalarOps<math::Lanes<S, N>> {
     // goes to all of them: the same bits each lane's own call gives.
     template <class F, class... More>
     static L mapLive(const L& a, F f, const More&... more) {
-        L r = a;
-        const uint32_t live = L::liveBits();
-        if (!live) return r;
-        const int first = std::countr_zero(live);
-        if (uniformBits(live, first, a) && (uniformBits(live, first, more) && ...)) {
-            const S value = f(a.v[first], more.v[first]...);
-            L::forLiveLanes([&](int i) { r.v[i] = value; });
-            return r;
+        L r;
+        if (!once(r, f, a, more...)) {
+            r = a;
+            L::forLiveLanes([&](int i) { r.v[i] = f(a.v[i], more.v[i]...); });
         }
-        L::forLiveLanes([&](int i) { r.v[i] = f(a.v[i], more.v[i]...); });
         return r;
     }
-    // pow where every live lane holds one base and one exponent (the fractal pyramid's pow(2, -n)): r gets the one
-    // result, the bits of each lane's exp2(y * log2(x)), and true. False, with r untouched, otherwise.
-    static bool powOnce(const L& x, const L& y, L& r) {
+    // Where there are live lanes and each holds the same bits in every operand: f once, r = a with that one result
+    // in its live lanes, and true. False, with r untouched, otherwise.
+    template <class F, class... More>
+    static bool once(L& r, F f, const L& a, const More&... more) {
         const uint32_t live = L::liveBits();
         if (!live) return false;
         const int first = std::countr_zero(live);
-        if (!uniformBits(live, first, x) || !uniformBits(live, first, y)) return false;
-        r = L(hlsl::pow(x.v[first], y.v[first]));
+        if (!(uniformBits(live, first, a) && (uniformBits(live, first, more) && ...))) return false;
+        r = liveOnly(live, L(f(a.v[first], more.v[first]...)), a);
         return true;
+    }
+    // `result` in the lanes of `live`, `keep` in the others: one blend for float lanes.
+    static L liveOnly(uint32_t live, const L& result, const L& keep) {
+        if (live == math::kLaneBits<N>) return result;
+        L r = keep;
+        if constexpr (std::is_same_v<S, float>) {
+            typename math::detail::LaneStorage<uint32_t, N>::type laneBit;
+            for (int i = 0; i < N; ++i) laneBit[i] = 1u << i;
+            r.v = (laneBit & live) != 0u ? result.v : keep.v;
+        } else {
+            for (uint32_t l = live; l; l &= l - 1) r.v[std::countr_zero(l)] = result.v[std::countr_zero(l)];
+        }
+        return r;
+    }
+    // pow where every live lane holds one base and one exponent (the fractal pyramid's pow(2, -n)): once, the bits
+    // of each lane's exp2(y * log2(x)); the lanes that are not live keep x, as mapLive leaves them.
+    static bool powOnce(const L& x, const L& y, L& r) {
+        return once(r, [](S a, S b) { return hlsl::pow(a, b); }, x, y);
     }
     // Whether every lane of `live` holds lane `first`'s bits (SIMD types only: a comparison and a mask test).
     static bool uniformBits(uint32_t live, int first, const L& x) {
@@ -478,12 +495,7 @@ struct ScalarOps<math::Lanes<S, N>> {
                     if ((live >> i) & 0xFFu) math::transcendental8(F, in + i, out + i, live >> i);
                 std::memcpy(&r.v, out, sizeof(out));
             }
-            if (live != (N >= 32 ? ~0u : (1u << N) - 1u)) {
-                Bits laneBit;
-                for (int i = 0; i < N; ++i) laneBit[i] = 1u << i;
-                r.v = (laneBit & live) != 0u ? r.v : x.v;
-            }
-            return r;
+            return liveOnly(live, r, x);
         } else {
             return mapLive(x, scalar);
         }
