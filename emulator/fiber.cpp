@@ -84,6 +84,11 @@ thread_local Fiber* tCurrentFiber = nullptr;
 
 size_t pageSize() { return size_t(sysconf(_SC_PAGESIZE)); }
 
+constexpr size_t kCacheLine = 64;
+// How much of a fiber's stack prefetch() asks for: the frames a lane's resume returns through (the fiber switch,
+// TraceRay's wait and TraceRay, about 2 KB). Measured with 1 KB and 4 KB too (docs/performance.md).
+constexpr size_t kPrefetchBytes = 2048;
+
 void saveLocals(void** into) {
     const FiberLocal* locals = fiberLocals();
     for (size_t i = 0, n = fiberLocalCount(); i < n; ++i) into[i] = locals[i].get();
@@ -97,8 +102,10 @@ void loadLocals(void* const* from) {
 
 size_t Fiber::defaultStackBytes() { return REFRAY_FIBER_ASAN ? size_t(16) << 20 : size_t(2) << 20; }
 
-Fiber::Fiber(size_t stackBytes) {
+Fiber::Fiber(size_t stackBytes, unsigned colour) {
     const size_t page = pageSize();
+    REFRAY_CHECK(colour < kColours, "fiber stack colour " << colour << " is outside 0.." << kColours - 1);
+    colourBytes_ = size_t(colour) * kCacheLine;
     mapped_ = (stackBytes + page - 1) / page * page + page;
     stack_ = mmap(nullptr, mapped_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
     REFRAY_CHECK(stack_ != MAP_FAILED, "cannot map a fiber stack of " << mapped_ << " bytes: " << std::strerror(errno));
@@ -129,7 +136,7 @@ void Fiber::start(std::function<void()> body) {
 #endif
     // The first switch into the fiber pops this frame and "returns" into the trampoline, which calls entry(this)
     // with the stack 16-byte aligned at the call.
-    const uintptr_t afterReturn = (reinterpret_cast<uintptr_t>(bottom + usable) - 64) & ~uintptr_t(15);
+    const uintptr_t afterReturn = (reinterpret_cast<uintptr_t>(bottom + usable) - 64 - colourBytes_) & ~uintptr_t(15);
     auto* frame = reinterpret_cast<uint64_t*>(afterReturn - 9 * sizeof(uint64_t));
     uint32_t mxcsr = 0;
     uint16_t fpuControl = 0;
@@ -147,6 +154,14 @@ void Fiber::start(std::function<void()> body) {
     fiberSp_ = frame;
     // The fiber starts with the fiber-local values its starter has now.
     saveLocals(locals_);
+}
+
+void Fiber::prefetch() const {
+    // The frames above the saved stack pointer, up to the top of the stack: what the fiber pops and returns into.
+    const char* from = static_cast<const char*>(fiberSp_);
+    const char* top = static_cast<const char*>(stack_) + mapped_;
+    const char* to = std::min(top, from + kPrefetchBytes);
+    for (const char* line = from; line < to; line += kCacheLine) __builtin_prefetch(line, 1, 3);
 }
 
 void Fiber::resume() {

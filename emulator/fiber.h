@@ -3,7 +3,8 @@
 // fiber, so that a lane that calls TraceRay can wait while the other lanes reach theirs; the wave then traverses
 // their rays together. Switching is a handful of instructions (callee-saved registers, MXCSR and the x87 control
 // word, the stack pointer) plus the registered fiber-local values (core/fiber_local.h); AddressSanitizer is told
-// about every switch.
+// about every switch. A switch's cost is mostly the first touches of the other stack: a wave prefetches the stack of
+// the lane it resumes next, and gives its lanes' stacks different colours (cache-set offsets).
 #pragma once
 
 #include <cstddef>
@@ -16,8 +17,12 @@ namespace refray::dxr {
 
 class Fiber {
 public:
-    // A fiber whose stack holds `stackBytes` (reserved, not committed until used) plus a guard page.
-    explicit Fiber(size_t stackBytes);
+    // A fiber whose stack holds `stackBytes` (reserved, not committed until used) plus a guard page. Its frames start
+    // `colour` cache lines (at most 63) below the top of the stack: fibers whose stacks lie a multiple of the page
+    // size apart would otherwise put their hottest frames in the same sets of the L1 cache (a wave gives each lane's
+    // fiber a colour of its own).
+    explicit Fiber(size_t stackBytes, unsigned colour = 0);
+    static constexpr unsigned kColours = 64;  // the 64-byte lines of a 4 KiB page
     ~Fiber();
     Fiber(const Fiber&) = delete;
     Fiber& operator=(const Fiber&) = delete;
@@ -26,6 +31,9 @@ public:
     void start(std::function<void()> body);
     // Runs the fiber until it yields or its body returns. An exception that leaves the body is rethrown here.
     void resume();
+    // Asks the cache for the top of the fiber's saved stack, the frames resume() pops and returns into first. A wave
+    // calls it for the lane it resumes next while the current one runs (no effect on what runs).
+    void prefetch() const;
     // Called on a fiber: goes back to the resume() that entered it; returns when it is resumed again.
     static void yield();
     // Whether a started body has not returned yet.
@@ -44,6 +52,7 @@ private:
 
     void* stack_ = nullptr;  // the mapping, guard page first
     size_t mapped_ = 0;
+    size_t colourBytes_ = 0;  // left free at the top of the stack
     void* fiberSp_ = nullptr;   // the fiber's saved stack pointer while it is not running
     void* callerSp_ = nullptr;  // the resumer's saved stack pointer while the fiber runs
     Fiber* previous_ = nullptr;  // the fiber (or null: the thread) that resumed this one

@@ -18,6 +18,21 @@ Wave::Wave(DispatchState& ds) {
     }
 }
 
+namespace {
+
+// Resumes the fibers of `lanes` in lane order, each after asking the cache for the stack of the lane after it: the
+// first touches of a resumed lane's frames were most of the cost of a switch (docs/performance.md).
+void resumeLanes(Wave& wave, LaneMask lanes) {
+    for (LaneMask::Iterator it = lanes.begin(); it != lanes.end();) {
+        Fiber& fiber = *wave.fibers[size_t(*it)];
+        ++it;
+        if (it != lanes.end()) wave.fibers[size_t(*it)]->prefetch();
+        fiber.resume();
+    }
+}
+
+}  // namespace
+
 void runWave(Wave& wave, std::span<const uvec3> launches, const LaunchFunction& launch) {
     REFRAY_ASSERT(launches.size() <= size_t(kMaxWaveWidth), "a wave of " << launches.size() << " lanes");
     wave.parked = LaneMask();
@@ -26,26 +41,29 @@ void runWave(Wave& wave, std::span<const uvec3> launches, const LaunchFunction& 
     for (size_t i = 0; i < launches.size(); ++i) {
         WaveLane& lane = wave.lanes[i];
         lane.failure = nullptr;
-        if (!wave.fibers[i]) wave.fibers[i] = std::make_unique<Fiber>(Fiber::defaultStackBytes());
+        // Lane i's frames start 11*i lines (mod a page) below its stack's top: the lanes' hottest frames spread over
+        // the L1 cache's sets instead of sharing them (the stacks' mappings lie whole pages apart).
+        if (!wave.fibers[i])
+            wave.fibers[i] = std::make_unique<Fiber>(Fiber::defaultStackBytes(), unsigned(i) * 11u % Fiber::kColours);
         lane.launch = launches[i];
         wave.fibers[i]->start([&launch, &lane] { launch(lane.ts, lane.launch); });  // two pointers: no allocation
     }
     // Each lane runs until its first TraceRay, wave call or its end; then the waiting calls run grouped and their
     // lanes go on, or, when no lane waits on a call, the parked rays traverse together and their lanes go on, until
     // none is left.
-    for (size_t i = 0; i < launches.size(); ++i) wave.fibers[i]->resume();
+    resumeLanes(wave, LaneMask::first(int(launches.size())));
     while (wave.parked.any() || wave.calling.any()) {
         if (wave.calling.any()) {
             const LaneMask calls = wave.calling;
             wave.calling = LaneMask();
             runWaveCalls(wave, calls);
-            for (int i : calls) wave.fibers[size_t(i)]->resume();
+            resumeLanes(wave, calls);
             continue;
         }
         const LaneMask packet = wave.parked;
         wave.parked = LaneMask();
         traversePacket(wave, packet);
-        for (int i : packet) wave.fibers[size_t(i)]->resume();
+        resumeLanes(wave, packet);
     }
 }
 

@@ -127,5 +127,38 @@ TEST(Fiber, AnExceptionLeavingTheBodyReachesTheResumerWithItsControlState) {
     EXPECT_FALSE(fiber.running());
 }
 
+TEST(Fiber, AColourMovesTheFramesThatManyLinesDownAndPrefetchChangesNothing) {
+    // A wave gives each lane's stack a colour (its frames start that many cache lines below the top) and prefetches
+    // the next lane's stack before resuming it. The same body at the same depth on stacks of every colour: its frame
+    // lies 64 * colour bytes lower within the page, and the body runs the same with prefetches before each resume.
+    const auto localOffset = [](unsigned colour, bool prefetch) {
+        Fiber fiber(Fiber::defaultStackBytes(), colour);
+        uintptr_t at = 0;
+        int steps = 0;
+        fiber.start([&] {
+            at = reinterpret_cast<uintptr_t>(__builtin_frame_address(0));  // the real stack, sanitizers or not
+            ++steps;
+            Fiber::yield();
+            ++steps;
+        });
+        if (prefetch) fiber.prefetch();
+        fiber.resume();
+        if (prefetch) fiber.prefetch();
+        fiber.resume();
+        EXPECT_FALSE(fiber.running());
+        EXPECT_EQ(steps, 2) << "colour " << colour;
+        return at % 4096;
+    };
+    const uintptr_t plain = localOffset(0, false);
+    for (unsigned colour = 0; colour < Fiber::kColours; ++colour) {
+        const uintptr_t got = localOffset(colour, colour % 2 == 1);
+        EXPECT_EQ((plain + 4096 - got) % 4096, 64u * colour) << "colour " << colour;
+    }
+}
+
+TEST(Fiber, AColourBeyondAPageIsRefused) {
+    EXPECT_THROW(Fiber(Fiber::defaultStackBytes(), Fiber::kColours), std::exception);
+}
+
 }  // namespace
 }  // namespace refray::dxr
