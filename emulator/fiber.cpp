@@ -86,7 +86,7 @@ size_t pageSize() { return size_t(sysconf(_SC_PAGESIZE)); }
 
 constexpr size_t kCacheLine = 64;
 // How much of a fiber's stack prefetch() asks for: the frames a lane's resume returns through (the fiber switch,
-// TraceRay's wait and TraceRay, about 2 KB). Measured with 1 KB and 4 KB too (docs/performance.md).
+// TraceRay's wait and TraceRay, about 2 KB); 4 KB measured the same or a little worse (docs/performance.md).
 constexpr size_t kPrefetchBytes = 2048;
 
 void saveLocals(void** into) {
