@@ -3,8 +3,9 @@
 // fiber, so that a lane that calls TraceRay can wait while the other lanes reach theirs; the wave then traverses
 // their rays together. Switching is a handful of instructions (callee-saved registers, MXCSR and the x87 control
 // word, the stack pointer) plus the registered fiber-local values (core/fiber_local.h); AddressSanitizer is told
-// about every switch. A switch's cost is mostly the first touches of the other stack: a wave prefetches the stack of
-// the lane it resumes next, and gives its lanes' stacks different colours (cache-set offsets).
+// about every switch. What a switch's perf samples show is mostly the stall of the first touches of the other
+// stack, not its instructions: a wave prefetches the stack of the lane it resumes next, and gives its lanes' stacks
+// different colours (cache-set offsets).
 #pragma once
 
 #include <cstddef>

@@ -20,8 +20,8 @@ Wave::Wave(DispatchState& ds) {
 
 namespace {
 
-// Resumes the fibers of `lanes` in lane order, each after asking the cache for the stack of the lane after it: the
-// first touches of a resumed lane's frames were most of the cost of a switch (docs/performance.md).
+// Resumes the fibers of `lanes` in lane order, each after asking the cache for the stack of the lane after it: a
+// resumed lane's first touches of its frames stall (docs/performance.md).
 void resumeLanes(Wave& wave, LaneMask lanes) {
     for (LaneMask::Iterator it = lanes.begin(); it != lanes.end();) {
         Fiber& fiber = *wave.fibers[size_t(*it)];

@@ -1,6 +1,7 @@
-// Fibers (emulator/fiber.h): the floating-point control state follows the code that set it. The switch loads MXCSR
-// and the x87 control word only where they differ from the values in force, so these tests switch between fibers
-// whose values differ, and between fibers whose values are equal, and check each side's values after every switch.
+// Fibers (emulator/fiber.h): the floating-point control state follows the code that set it, and a stack colour and a
+// prefetch move where the frames lie but not what runs. The switches go between fibers whose MXCSR values differ and
+// between fibers whose values are equal, so a switch that skipped a load it needs would show, and each side's
+// values are checked after every switch.
 #include <gtest/gtest.h>
 #include <xmmintrin.h>
 
@@ -16,6 +17,8 @@ namespace {
 
 constexpr uint32_t kFlushDenormals = 0x8040u;  // MXCSR's FTZ (bit 15) and DAZ (bit 6)
 constexpr uint32_t kRoundTowardZero = 0x6000u;  // MXCSR's rounding control = 11
+constexpr uintptr_t kCacheLine = 64;
+constexpr uintptr_t kPage = kCacheLine * Fiber::kColours;  // the span of the colours: a 4 KiB page
 
 uint16_t x87Control() {
     uint16_t cw = 0;
@@ -147,12 +150,12 @@ TEST(Fiber, AColourMovesTheFramesThatManyLinesDownAndPrefetchChangesNothing) {
         fiber.resume();
         EXPECT_FALSE(fiber.running());
         EXPECT_EQ(steps, 2) << "colour " << colour;
-        return at % 4096;
+        return at % kPage;
     };
     const uintptr_t plain = localOffset(0, false);
     for (unsigned colour = 0; colour < Fiber::kColours; ++colour) {
         const uintptr_t got = localOffset(colour, colour % 2 == 1);
-        EXPECT_EQ((plain + 4096 - got) % 4096, 64u * colour) << "colour " << colour;
+        EXPECT_EQ((plain + kPage - got) % kPage, kCacheLine * colour) << "colour " << colour;
     }
 }
 
