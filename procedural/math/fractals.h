@@ -8,6 +8,7 @@
 // scalar T the masks are bools and every select picks what the HLSL's branch picks: the scalar results are unchanged.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstdint>
@@ -15,6 +16,7 @@
 #include "procedural/math/analytic.h"
 #include "procedural/math/hlsl.h"
 #include "procedural/math/lanes.h"
+#include "procedural/math/march_queue.h"
 #include "procedural/math/ray.h"
 #include "procedural/math/sdf.h"
 
@@ -115,52 +117,141 @@ struct MandelbulbHit {
     vec3<T> pos{};     // the last sample; when the loop runs out it lags thit by one step (H14)
 };
 
+// The bounding sphere's interval: dis = isphere(centre 0, radius 1.25), clipped to [0, 1000] for the rays that meet
+// the sphere (inSphere).
+template <typename T>
+struct MandelbulbBounds {
+    LaneMask<T> inSphere = LaneMask<T>(false);
+    vec2<T> dis{};
+};
+
+template <typename T>
+MandelbulbBounds<T> mandelbulbBounds(const vec3<T>& ro, const vec3<T>& rd) {
+    MandelbulbBounds<T> b;
+    b.dis = isphere(vec4<T>(T(0), T(0), T(0), T(1.25)), ro, rd);
+    b.inSphere = !(b.dis.y < T(0));
+    b.dis.x = hlsl::max(b.dis.x, T(0));
+    b.dis.y = hlsl::min(b.dis.y, T(1000));
+    return b;
+}
+
+// What the march carries from step to step: t, the last sample and its orbit trap.
+template <typename T>
+struct MandelbulbMarch {
+    T t = T(0);
+    vec3<T> pos = vec3<T>(T(0));
+    vec4<T> trap = vec4<T>(T(0));
+};
+
+// One step of the march for the `running` lanes, which it clears for the lanes that stop.
+// PORT: pos and trap are assigned before the break (the lane that breaks keeps them), t after it.
+template <typename T>
+void mandelbulbStep(const vec3<T>& ro, const vec3<T>& rd, T disY, T threshold, int iterations, MandelbulbMarch<T>& m,
+                    LaneMask<T>& running) {
+    const LiveLanes live(running);
+    const vec3<T> posNext = ro + rd * m.t;
+    const T th = threshold * m.t;
+    vec4<T> trapNext;
+    const T h = mdist(posNext, trapNext, iterations);
+    m.pos = select(running, posNext, m.pos);
+    m.trap = select(running, trapNext, m.trap);
+    running = running && !(m.t > disY || h < th);  // if (t > dis.y || h < th) break;
+    m.t = select(running, m.t + h, m.t);           // t += h;
+}
+
 // Bounding sphere (centre 0, radius 1.25; unit rd assumed) gives [dis.x, dis.y], clipped to
 // [0, 1000]. Up to iMax steps: pos = ro + rd*t; break if t > dis.y or mdist(pos) < 1e-4*t;
 // t += h. Hit iff t < dis.y afterwards, converged or not. stepScale is ignored, as in the HLSL.
 // PORT: takes iMax (MandelbulbIterationCount) instead of (time, instanceId), and returns the
 // HLSL `out` thit/attr as a struct. PORT: `params` holds the HLSL's constants (MandelbulbParams).
+// PORT: the HLSL's one function is mandelbulbBounds, the loop of mandelbulbStep and the hit test, so that
+// MandelbulbDistanceQueue runs the same steps for a queue of rays.
 template <typename T>
 MandelbulbHit<T> MandelbulbDistance(const vec3<T>& ro, const vec3<T>& rd, int iMax,
                                     const MandelbulbParams<T>& params = {}) {
     MandelbulbHit<T> result;
 
-    vec2<T> dis = isphere(vec4<T>(T(0), T(0), T(0), T(1.25)), ro, rd);
     // PORT: `if (dis.y < 0) return result;` for the lanes whose ray misses the sphere: they stay out of the march
     // and keep result's initial values.
-    const LaneMask<T> inSphere = !(dis.y < T(0));
-    if (!anyLane(inSphere)) return result;
-    dis.x = hlsl::max(dis.x, T(0));
-    dis.y = hlsl::min(dis.y, T(1000));
+    const MandelbulbBounds<T> b = mandelbulbBounds(ro, rd);
+    if (!anyLane(b.inSphere)) return result;
 
-    vec4<T> trap(T(0));
-    T t = dis.x;
-    vec3<T> pos(T(0));
-
-    LaneMask<T> running = inSphere;
-    for (int i = 0; i < iMax && anyLane(running); i++) {
-        const LiveLanes live(running);
-        const vec3<T> posNext = ro + rd * t;
-        const T th = params.threshold * t;
-        vec4<T> trapNext;
-        const T h = mdist(posNext, trapNext, params.iterations);
-        // PORT: pos and trap are assigned before the break (the lane that breaks keeps them), t after it.
-        pos = select(running, posNext, pos);
-        trap = select(running, trapNext, trap);
-        running = running && !(t > dis.y || h < th);  // if (t > dis.y || h < th) break;
-        t = select(running, t + h, t);                // t += h;
-    }
+    MandelbulbMarch<T> m;
+    m.t = b.dis.x;
+    LaneMask<T> running = b.inSphere;
+    for (int i = 0; i < iMax && anyLane(running); i++)
+        mandelbulbStep(ro, rd, b.dis.y, params.threshold, params.iterations, m, running);
 
     // if (t < dis.y) { ... }
-    const LaneMask<T> hit = inSphere && (t < dis.y);
+    const LaneMask<T> hit = b.inSphere && (m.t < b.dis.y);
     if (anyLane(hit)) {
         result.hit = hit;
-        result.thit = select(hit, t, result.thit);
-        result.normal = select(hit, calcNormal(pos, params.normalOffset, params.iterations), result.normal);
-        result.color = select(hit, trap, result.color);
+        result.thit = select(hit, m.t, result.thit);
+        result.normal = select(hit, calcNormal(m.pos, params.normalOffset, params.iterations), result.normal);
+        result.color = select(hit, m.trap, result.color);
     }
-    result.pos = select(inSphere, pos, result.pos);
+    result.pos = select(b.inSphere, m.pos, result.pos);
     return result;
+}
+
+// MandelbulbDistance for `count` (at most kMaxMarchQueue) rays ro[k], rd[k] in S over the lanes of L = Lanes<S, N>:
+// the march refilled from the queue as rays stop (march_queue.h), then calcNormal over the lanes for the rays that
+// hit, N at a time. out[k] is bit for bit MandelbulbDistance(ro[k], rd[k], iMax, params) in S.
+// PORT: not in the HLSL: the lanes' MandelbulbDistance, with a queue of rays instead of one ray per lane.
+template <class L, class S = typename L::Scalar>
+void MandelbulbDistanceQueue(const vec3<S>* ro, const vec3<S>* rd, int count, int iMax, MandelbulbHit<S>* out,
+                             const MandelbulbParams<S>& params = {}) {
+    constexpr int N = L::kCount;
+    std::array<MandelbulbBounds<S>, kMaxMarchQueue> bounds{};
+    std::array<MandelbulbMarch<S>, kMaxMarchQueue> march{};
+    for (int k = 0; k < count; ++k) {
+        bounds[size_t(k)] = mandelbulbBounds(ro[k], rd[k]);
+        march[size_t(k)].t = bounds[size_t(k)].dis.x;  // where a ray that never marches stays
+    }
+    vec3<L> roL(L(S(0))), rdL(L(S(0)));
+    L disY(S(0));
+    MandelbulbMarch<L> m;
+    marchQueue<L>(
+        count, iMax, [&](int k) { return bounds[size_t(k)].inSphere; },
+        [&](int j, int k) {
+            setLane(roL, j, ro[k]);
+            setLane(rdL, j, rd[k]);
+            setLane(disY, j, bounds[size_t(k)].dis.y);
+            setLane(m.t, j, march[size_t(k)].t);
+            setLane(m.pos, j, march[size_t(k)].pos);
+            setLane(m.trap, j, march[size_t(k)].trap);
+        },
+        [&](LaneMask<L>& running) {
+            mandelbulbStep(roL, rdL, disY, L(params.threshold), params.iterations, m, running);
+        },
+        [&](int j, int k) {
+            march[size_t(k)].t = lane(m.t, j);
+            march[size_t(k)].pos = lane(m.pos, j);
+            march[size_t(k)].trap = lane(m.trap, j);
+        });
+    std::array<int, kMaxMarchQueue> hits{};
+    int hitCount = 0;
+    for (int k = 0; k < count; ++k) {
+        const MandelbulbBounds<S>& b = bounds[size_t(k)];
+        const MandelbulbMarch<S>& mk = march[size_t(k)];
+        out[k] = MandelbulbHit<S>();
+        if (!b.inSphere) continue;
+        out[k].pos = mk.pos;
+        if (!(mk.t < b.dis.y)) continue;  // if (t < dis.y)
+        out[k].hit = true;
+        out[k].thit = mk.t;
+        out[k].color = mk.trap;
+        hits[size_t(hitCount++)] = k;
+    }
+    for (int first = 0; first < hitCount; first += N) {
+        const int lanes = std::min(N, hitCount - first);
+        vec3<L> pos;
+        for (int j = 0; j < N; ++j)  // lanes past the rays copy the last one
+            setLane(pos, j, march[size_t(hits[size_t(first + std::min(j, lanes - 1))])].pos);
+        const LiveLanes batch(kLaneBits<N> >> (N - lanes), 0);
+        const vec3<L> normal = calcNormal(pos, L(params.normalOffset), params.iterations);
+        for (int j = 0; j < lanes; ++j) out[hits[size_t(first + j)]].normal = lane(normal, j);
+    }
 }
 
 }  // namespace mandelbulb
@@ -363,7 +454,7 @@ vec2<T> raycast(const vec3<T>& ro, const vec3<T>& rd, const vec4<T>& c = kc<T>()
 }
 
 // The most rays raycastQueue takes: a wave's (16).
-inline constexpr int kMaxRaycastQueue = 16;
+inline constexpr int kMaxRaycastQueue = kMaxMarchQueue;
 
 // Lane i of a march over lanes, and its writing.
 template <class L, class S = typename L::Scalar>
@@ -384,15 +475,13 @@ void setMarchLane(RaycastMarch<L>& m, int i, const RaycastMarch<S>& value) {
 }
 
 // raycast for `count` (at most kMaxRaycastQueue) rays ro[k], rd[k] in S over the lanes of L = Lanes<S, N>,
-// refilled: a lane whose ray stops marching takes the next ray of the queue at once, so the lanes keep marching
-// until the queue is empty, rather than each group of N until its slowest ray ends. Each ray takes the steps raycast
-// takes for it alone (raycastStep in its own lane; a lane's result never depends on its neighbours, lanes.h), so
-// out[k] is bit for bit raycast(ro[k], rd[k], ...) in S. c, deltaT, iMax, maxSteps and precis are every ray's.
+// refilled from the queue as rays stop (march_queue.h). Each ray takes the steps raycast takes for it alone
+// (raycastStep in its own lane), so out[k] is bit for bit raycast(ro[k], rd[k], ...) in S. c, deltaT, iMax, maxSteps
+// and precis are every ray's.
 // PORT: not in the HLSL; a GPU would run its rays' raycast in one wave, each lane until its own ray ends.
 template <class L, class S = typename L::Scalar>
 void raycastQueue(const vec3<S>* ro, const vec3<S>* rd, int count, vec2<S>* out, const vec4<L>& c = kc<L>(),
                   S deltaT = S(0), int iMax = kIterations, int maxSteps = kMarchSteps, S precis = kPrecis<S>) {
-    constexpr int N = L::kCount;
     std::array<RaycastBounds<S>, kMaxRaycastQueue> bounds{};
     std::array<RaycastMarch<S>, kMaxRaycastQueue> march{};
     for (int k = 0; k < count; ++k) {
@@ -402,48 +491,16 @@ void raycastQueue(const vec3<S>* ro, const vec3<S>* rd, int count, vec2<S>* out,
     vec3<L> roL(L(S(0))), rdL(L(S(0)));
     L tmaxL(S(0));
     RaycastMarch<L> m;
-    LaneMask<L> running(false);
-    std::array<int, size_t(N)> ray{};  // the ray each lane marches
-    std::array<int, size_t(N)> steps{};
-    int next = 0;
-    // Puts the next ray that marches into lane j (a ray ruled out, or with no steps, keeps its start); or, when the
-    // queue is empty, leaves the lane out.
-    const auto load = [&](int j) {
-        while (next < count && (bounds[size_t(next)].ruledOut || maxSteps <= 0)) ++next;
-        if (next == count) {
-            setLane(running, j, false);
-            return;
-        }
-        const int k = next++;
-        ray[size_t(j)] = k;
-        steps[size_t(j)] = 0;
-        setLane(roL, j, ro[k]);
-        setLane(rdL, j, rd[k]);
-        setLane(tmaxL, j, bounds[size_t(k)].tmax);
-        setMarchLane(m, j, march[size_t(k)]);
-        setLane(running, j, true);
-    };
-    for (int j = 0; j < N; ++j) load(j);
-    // The lanes with no ray hold the first marching lane's inputs, so that their math stays sane.
-    const int first = std::countr_zero(laneBits(running));  // 32 when no ray marches: nothing below runs
-    for (int j = 0; j < N && first < N; ++j)
-        if (!lane(running, j)) {
-            setLane(roL, j, lane(roL, first));
-            setLane(rdL, j, lane(rdL, first));
-            setLane(tmaxL, j, lane(tmaxL, first));
-            setMarchLane(m, j, marchLane(m, first));
-        }
-    const LiveLanes queueLanes(laneBits(LaneMask<L>(true)), 0);  // the queue's lanes, whatever encloses it
-    while (anyLane(running)) {
-        const LaneMask<L> stepped = running;
-        raycastStep(roL, rdL, c, iMax, L(precis), tmaxL, m, running);
-        for (int j = 0; j < N; ++j) {
-            if (!lane(stepped, j)) continue;
-            if (lane(running, j) && ++steps[size_t(j)] < maxSteps) continue;
-            march[size_t(ray[size_t(j)])] = marchLane(m, j);  // the ray stopped, or took its last step
-            load(j);
-        }
-    }
+    marchQueue<L>(
+        count, maxSteps, [&](int k) { return !bounds[size_t(k)].ruledOut; },
+        [&](int j, int k) {
+            setLane(roL, j, ro[k]);
+            setLane(rdL, j, rd[k]);
+            setLane(tmaxL, j, bounds[size_t(k)].tmax);
+            setMarchLane(m, j, march[size_t(k)]);
+        },
+        [&](LaneMask<L>& running) { raycastStep(roL, rdL, c, iMax, L(precis), tmaxL, m, running); },
+        [&](int j, int k) { march[size_t(k)] = marchLane(m, j); });
     for (int k = 0; k < count; ++k) out[k] = raycastResult(bounds[size_t(k)], march[size_t(k)]);
 }
 

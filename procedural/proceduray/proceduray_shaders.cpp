@@ -545,17 +545,34 @@ void Intersection_Mandelbulb(IntersectionWave& wave, const Accuracy& accuracy) {
     const int iMax = mandelbulbStepCount(
         math::mandelbulb::MandelbulbIterationCount(T(group.sceneCB.elapsedTime), int(group.aabbCB.instanceIndex)),
         accuracy);
-    const math::Ray<L> localRay = lanes.template localRay<L>();
-    const math::mandelbulb::MandelbulbHit<L> primitiveTest =
-        math::mandelbulb::MandelbulbDistance(localRay.origin, localRay.direction, iMax, mandelbulbParams<L>(accuracy));
+    // PORT: over lanes, the marching lanes' rays go through MandelbulbDistanceQueue (up to a whole wave of them: the
+    // shader takes kMaxWaveWidth lanes a call), whose lanes take the next ray as soon as theirs ends.
+    const math::mandelbulb::MandelbulbParams<T> params = mandelbulbParams<T>(accuracy);
+    std::array<math::mandelbulb::MandelbulbHit<T>, kMaxWaveWidth> primitiveTest{};
+    if constexpr (math::kIsLanes<L>) {
+        std::array<tvec3<T>, kMaxWaveWidth> ro{}, rd{};
+        std::array<math::mandelbulb::MandelbulbHit<T>, kMaxWaveWidth> queued{};
+        int count = 0;
+        for (int i : marching) {
+            ro[size_t(count)] = in[size_t(i)].localRay.origin;
+            rd[size_t(count++)] = in[size_t(i)].localRay.direction;
+        }
+        math::mandelbulb::MandelbulbDistanceQueue<L>(ro.data(), rd.data(), count, iMax, queued.data(), params);
+        count = 0;
+        for (int i : marching) primitiveTest[size_t(i)] = queued[size_t(count++)];
+    } else {
+        primitiveTest[size_t(marching.lowest())] =
+            math::mandelbulb::MandelbulbDistance(group.localRay.origin, group.localRay.direction, iMax, params);
+    }
 
     wave.forEachLane([&](int i, ShaderContext& ctx) {
         if (!marching.test(i)) return;
-        const T thit = math::lane(primitiveTest.thit, i);
-        if (!(math::lane(primitiveTest.hit, i) && thit < T(in[size_t(i)].extent.tCurrent))) return;
+        const math::mandelbulb::MandelbulbHit<T>& test = primitiveTest[size_t(i)];
+        const T thit = test.thit;
+        if (!(test.hit && thit < T(in[size_t(i)].extent.tCurrent))) return;
         ProceduralPrimitiveAttributes attr = kInitialAttributes;
-        attr.color = vec4(math::lane(primitiveTest.color, i));
-        attr.normal = vec3(NormalToWorld(ctx, math::lane(primitiveTest.normal, i)));
+        attr.color = vec4(test.color);
+        attr.normal = vec3(NormalToWorld(ctx, test.normal));
         wave.ReportHit(i, float(thit), /*hitKind*/ 0, attr);
     });
 }
@@ -704,7 +721,8 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
                                          const ProceduralPrimitiveAttributes& attr) {
             ClosestHit_Pacman<T>(ctx, traceRay, accuracy, effects, payload, attr);
         }));
-    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("Intersection_Mandelbulb", kWaveLanes,
+    // Mandelbulb: a whole wave's lanes a call, for MandelbulbDistanceQueue's refilled lanes.
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("Intersection_Mandelbulb", kMaxWaveWidth,
         in([accuracy](IntersectionWave& wave) {
             withLaneType<T>(wave, [&]<class L>() { Intersection_Mandelbulb<T, L>(wave, accuracy); });
         }), ReportHitEnd::Return);

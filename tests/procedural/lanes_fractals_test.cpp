@@ -251,6 +251,57 @@ TEST(LanesFractals, MandelbulbDistanceMatchesScalarPerLane) {
     EXPECT_GT(checkLanes("MandelbulbDistance(params)", rays, fnKnobs, flat, isHit), 0);
 }
 
+TEST(LanesFractals, MandelbulbQueuesGiveEachRayItsScalarResult) {
+    // MandelbulbDistanceQueue refills its lanes from a queue of up to 16 rays: every ray's result (hit, t, normal,
+    // orbit trap, last sample) is bit for bit the one-ray result, for every queue length 1..16, with rays that miss
+    // the bounding sphere (raysAtBall's spread puts some outside), rays that run out of steps (iMax 7), no steps at
+    // all (iMax 0: a ray inside the sphere hits at its entry, with calcNormal at the origin: NaN, H4), and the
+    // accuracy knobs' constants.
+    const std::vector<Input<float>> rays = raysAtBall(13, 200, glm::vec3(0), 1.6f);
+    mandelbulb::MandelbulbParams<float> knobs;
+    knobs.threshold = 0.01f;
+    knobs.iterations = 7;
+    knobs.normalOffset = 1e-3f;
+    int missed = 0, hits = 0, queues = 0;
+    for (const auto& [iMax, params] : {std::pair{129, mandelbulb::MandelbulbParams<float>{}},
+                                       std::pair{7, mandelbulb::MandelbulbParams<float>{}}, std::pair{0, knobs},
+                                       std::pair{60, knobs}}) {
+        size_t first = 0;
+        for (int count = 1; first < rays.size(); count = count % kMaxMarchQueue + 1) {
+            const int n = int(std::min<size_t>(size_t(count), rays.size() - first));
+            std::vector<glm::vec3> ro(static_cast<size_t>(n)), rd(static_cast<size_t>(n));
+            std::vector<mandelbulb::MandelbulbHit<float>> got(static_cast<size_t>(n));
+            for (int k = 0; k < n; ++k) {
+                ro[size_t(k)] = rays[first + size_t(k)].a;
+                rd[size_t(k)] = rays[first + size_t(k)].b;
+            }
+            mandelbulb::MandelbulbDistanceQueue<L>(ro.data(), rd.data(), n, iMax, got.data(), params);
+            ++queues;
+            for (int k = 0; k < n; ++k) {
+                const mandelbulb::MandelbulbHit<float> want =
+                    mandelbulb::MandelbulbDistance(ro[size_t(k)], rd[size_t(k)], iMax, params);
+                const auto flat = [](const mandelbulb::MandelbulbHit<float>& r) {
+                    Bits out;
+                    put(out, r.hit, 0);
+                    put(out, r.thit, 0);
+                    put(out, r.normal, 0);
+                    put(out, r.color, 0);
+                    put(out, r.pos, 0);
+                    return out;
+                };
+                EXPECT_EQ(flat(got[size_t(k)]), flat(want)) << "MandelbulbDistanceQueue: ray " << first + size_t(k) << " of a queue of " << n
+                                << ", iMax " << iMax;
+                missed += mandelbulb::mandelbulbBounds(ro[size_t(k)], rd[size_t(k)]).inSphere ? 0 : 1;
+                hits += want.hit ? 1 : 0;
+            }
+            first += size_t(n);
+        }
+    }
+    EXPECT_GT(missed, 0);
+    EXPECT_GT(hits, 0);
+    EXPECT_GT(queues, 40);
+}
+
 TEST(LanesFractals, MandelbulbMdistAndNormalMatchScalarPerLane) {
     std::vector<Input<float>> pts = positions(12, 320, 1.3f, 1.0f);
     pts[5].a = glm::vec3(0);           // NaN (H4)
