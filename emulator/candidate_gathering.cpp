@@ -3,6 +3,7 @@
 #include "emulator/detail/candidate_gathering.h"
 
 #include <algorithm>
+#include <array>
 #include <random>
 
 #include "emulator/detail/candidate_processing.h"
@@ -14,17 +15,10 @@ namespace refray::dxr::detail {
 
 namespace {
 
-// The traversal shortcuts (GatherMode; docs/emulator.md, "Traversal shortcuts").
-struct ShortcutContext {
-    ThreadState* ts;
-    RayState* rs;
-    const Site* site;
-};
-
 // Closest: an in-range triangle the ordered loop commits whenever it reaches it: not culled, and either
 // opaque or in a pipeline without any-hit shaders (then nothing can ignore it).
 bool commitsSurely(const void* user, const Candidate& c) {
-    const auto& sc = *static_cast<const ShortcutContext*>(user);
+    const auto& sc = *static_cast<const GatherRay*>(user);
     const BuiltInstance& inst = sc.rs->tlas->instances()[c.instanceIndex];
     const BuiltGeometry& geom = inst.blas->geometries()[c.geometryIndex];
     const uint32_t flags = sc.rs->effectiveFlags;
@@ -36,7 +30,7 @@ bool commitsSurely(const void* user, const Candidate& c) {
 
 // FirstHit: the TRV-4 step for one candidate, as Embree meets it.
 bool processNow(void* user, const Candidate& c) {
-    auto& sc = *static_cast<ShortcutContext*>(user);
+    auto& sc = *static_cast<GatherRay*>(user);
     sc.ts->stats.candidates++;
     processCandidate(*sc.ts, *sc.rs, c, *sc.site);
     return sc.rs->searchEnded;
@@ -82,11 +76,14 @@ void orderCandidates(ThreadState& ts, RayState& rs, std::vector<Candidate>& cs) 
     std::shuffle(cs.begin(), cs.end(), rng);
 }
 
-// The body of both entry points: `out` receives the candidates, gathered in `mode`.
-void gatherInto(ThreadState& ts, RayState& rs, const Site& site, std::vector<Candidate>& out, GatherMode mode) {
+// The request of `ray` (its candidates into `out`, gathered in `mode`), counted in the statistics.
+void prepare(GatherRay& ray, std::vector<Candidate>& out, GatherMode mode) {
+    ThreadState& ts = *ray.ts;
+    const RayState& rs = *ray.rs;
     const DispatchState& ds = *ts.dispatch;
     out.clear();
-    GatherRequest gather;
+    GatherRequest& gather = ray.request;
+    gather = GatherRequest();
     gather.tlas = rs.tlas;
     gather.origin = rs.ray.Origin;
     gather.direction = rs.ray.Direction;
@@ -97,26 +94,72 @@ void gatherInto(ThreadState& ts, RayState& rs, const Site& site, std::vector<Can
     gather.skipProcedural = (rs.effectiveFlags & RAY_FLAG_SKIP_PROCEDURAL_PRIMITIVES) != 0;
     gather.alternateEdgeRule = ds.options.order == TraversalOrder::Adversarial && (ds.options.adversarialSeed & 1);
     gather.out = &out;
-    ShortcutContext shortcut{&ts, &rs, &site};
-    gather.user = &shortcut;
+    gather.user = &ray;
     gather.commitsSurely = commitsSurely;
     gather.onCandidate = processNow;
     gather.mode = mode;
     ts.stats.raysPerGatherMode[size_t(gather.mode)]++;
-    gatherCandidates(gather);
-    if (gather.mode != GatherMode::FirstHit) ts.stats.candidates += out.size();
+}
+
+// After the traversal: the candidates counted and put in order.
+void finish(GatherRay& ray) {
+    std::vector<Candidate>& out = *ray.request.out;
+    if (ray.request.mode != GatherMode::FirstHit) ray.ts->stats.candidates += out.size();
     else out.clear();  // processed during the traversal
-    orderCandidates(ts, rs, out);
+    orderCandidates(*ray.ts, *ray.rs, out);
+}
+
+// One ray alone: `out` receives its candidates, gathered in `mode`.
+void gatherAlone(ThreadState& ts, RayState& rs, const Site& site, std::vector<Candidate>& out, GatherMode mode) {
+    GatherRay ray{&ts, &rs, &site, {}, nullptr};
+    prepare(ray, out, mode);
+    gatherCandidates(ray.request);
+    finish(ray);
 }
 
 }  // namespace
 
-void gatherOrderedCandidates(ThreadState& ts, RayState& rs, const Site& site) {
-    gatherInto(ts, rs, site, ts.candidates, traversalMode(ts, rs));
+void gatherOrderedCandidates(std::span<GatherRay> rays) {
+    // Rays that take FirstHit go alone (their candidates are processed inside the traversal); the others traverse
+    // in packets of the rays that share a TLAS, in the order of their lanes.
+    std::array<bool, kMaxGatherPacket> pending{};
+    for (size_t i = 0; i < rays.size(); ++i) {
+        GatherRay& ray = rays[i];
+        const GatherMode mode = traversalMode(*ray.ts, *ray.rs);
+        if (mode != GatherMode::FirstHit) {
+            prepare(ray, ray.ts->candidates, mode);
+            pending[i] = true;
+            continue;
+        }
+        try {
+            gatherAlone(*ray.ts, *ray.rs, *ray.site, ray.ts->candidates, mode);
+        } catch (...) {
+            ray.error = std::current_exception();
+        }
+    }
+    for (size_t first = 0; first < rays.size(); ++first) {
+        if (!pending[first]) continue;
+        std::array<const GatherRequest*, kMaxGatherPacket> requests{};
+        std::array<size_t, kMaxGatherPacket> index{};
+        size_t count = 0;
+        for (size_t i = first; i < rays.size(); ++i)
+            if (pending[i] && rays[i].request.tlas == rays[first].request.tlas) {
+                pending[i] = false;
+                index[count] = i;
+                requests[count++] = &rays[i].request;
+            }
+        std::array<std::exception_ptr, kMaxGatherPacket> errors{};
+        gatherCandidatesPacket(std::span(requests.data(), count), std::span(errors.data(), count));
+        for (size_t k = 0; k < count; ++k) {
+            GatherRay& ray = rays[index[k]];
+            if (errors[k]) ray.error = errors[k];
+            else finish(ray);
+        }
+    }
 }
 
 void gatherQueryCandidates(ThreadState& ts, RayState& rs, const Site& site, std::vector<Candidate>& out) {
-    gatherInto(ts, rs, site, out, GatherMode::All);
+    gatherAlone(ts, rs, site, out, GatherMode::All);
 }
 
 }  // namespace refray::dxr::detail

@@ -1,6 +1,7 @@
 #include "emulator/embree_bridge.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <exception>
 #include <mutex>
@@ -60,15 +61,22 @@ EmbreeScene::~EmbreeScene() {
 
 namespace {
 
-// The extended intersect context (Embree's idiom): per-ray state rides along, never globals.
-struct GatherContext {
-    RTCIntersectContext embree;  // must be first
-    const GatherRequest* request;
+// What one ray of a gather carries through Embree's callbacks.
+struct RayGather {
+    const GatherRequest* request = nullptr;
     float nearestCommit = INFINITY;  // Closest: the smallest t of a triangle sure to commit
-    std::exception_ptr error;  // the first exception a callback caught (style rule 9)
+    std::exception_ptr error;        // the first exception a callback caught for this ray (style rule 9)
     // The object-space ray of the instance met last: its primitives share it.
     uint32_t objectRayInstance = ~0u;
     vec3 objectRayOrigin{0.0f}, objectRayDirection{0.0f};
+};
+
+// The extended intersect context (Embree's idiom): per-ray state rides along, never globals. A packet's rays are
+// told apart by their ray id (the index into `rays`), not by their place in a callback's packet: Embree may call
+// back with another packet size or order than it was given.
+struct GatherContext {
+    RTCIntersectContext embree;  // must be first
+    RayGather* rays = nullptr;   // one, or a packet's
 };
 
 // Embree's own intervals are widened a little: the exact tests decide, Embree only culls.
@@ -114,7 +122,7 @@ void boundsCallback(const RTCBoundsFunctionArguments* args) {
 }
 
 // refray's exact test of one primitive Embree reports: the candidate, or nothing if the ray misses it.
-bool exactCandidate(GatherContext& gather, void* geometryUserPtr, uint32_t prim, Candidate& c) {
+bool exactCandidate(RayGather& gather, uint32_t instanceIndex, void* geometryUserPtr, uint32_t prim, Candidate& c) {
     const GatherRequest& req = *gather.request;
     const auto* user = static_cast<const UserGeometry*>(geometryUserPtr);
     const BuiltGeometry& g = *user->geometry;
@@ -123,7 +131,6 @@ bool exactCandidate(GatherContext& gather, void* geometryUserPtr, uint32_t prim,
     if (triangles ? req.skipTriangles : req.skipProcedural) return false;
 
     // refray's own object-space ray (TRV-8): the exact inverse, not Embree's; once per instance met.
-    const uint32_t instanceIndex = gather.embree.instID[0];
     if (gather.objectRayInstance != instanceIndex) {
         const BuiltInstance& inst = req.tlas->instances()[instanceIndex];
         gather.objectRayInstance = instanceIndex;
@@ -153,46 +160,54 @@ bool exactCandidate(GatherContext& gather, void* geometryUserPtr, uint32_t prim,
 }
 
 // All and Closest: collect. Closest also shrinks Embree's tfar to the nearest triangle sure to commit.
-void gatherPrimitive(const RTCIntersectFunctionNArguments* args, GatherContext& ctx) {
-    const GatherRequest& req = *ctx.request;
+void gatherPrimitive(RayGather& gather, uint32_t instanceIndex, void* geometryUserPtr, uint32_t prim, float& tfar) {
+    const GatherRequest& req = *gather.request;
     Candidate c;
-    if (!exactCandidate(ctx, args->geometryUserPtr, args->primID, c)) return;
+    if (!exactCandidate(gather, instanceIndex, geometryUserPtr, prim, c)) return;
     if (req.mode == GatherMode::Closest) {
-        if (c.key > ctx.nearestCommit) return;  // the ordered loop would skip it (TRV-2)
+        if (c.key > gather.nearestCommit) return;  // the ordered loop would skip it (TRV-2)
         if (!c.procedural && req.tMin < c.t && c.t < req.tMax && req.commitsSurely(req.user, c)) {
-            ctx.nearestCommit = c.t;
-            RTCRayN_tfar(RTCRayHitN_RayN(args->rayhit, args->N), args->N, 0) = widenedFar(c.t);
+            gather.nearestCommit = c.t;
+            tfar = widenedFar(c.t);
         }
     }
     req.out->push_back(c);
 }
 
-// Embree swallows exceptions, so the callbacks catch everything, stop the traversal and leave the error
-// for gatherCandidates to rethrow once Embree has returned.
+// Embree swallows exceptions, so the callbacks catch everything, stop the ray's traversal and leave the error
+// for the gather to rethrow once Embree has returned.
 void intersectCallback(const RTCIntersectFunctionNArguments* args) {
-    if (!args->valid[0]) return;
     auto* ctx = reinterpret_cast<GatherContext*>(args->context);
-    if (ctx->error) return;
-    try {
-        gatherPrimitive(args, *ctx);
-    } catch (...) {
-        ctx->error = std::current_exception();
-        RTCRayN_tfar(RTCRayHitN_RayN(args->rayhit, args->N), args->N, 0) = -INFINITY;
+    RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, args->N);
+    const uint32_t instanceIndex = ctx->embree.instID[0];
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (!args->valid[i]) continue;
+        RayGather& gather = ctx->rays[RTCRayN_id(ray, args->N, i)];
+        if (gather.error) continue;
+        float& tfar = RTCRayN_tfar(ray, args->N, i);
+        try {
+            gatherPrimitive(gather, instanceIndex, args->geometryUserPtr, args->primID, tfar);
+        } catch (...) {
+            gather.error = std::current_exception();
+            tfar = -INFINITY;
+        }
     }
 }
 
-// FirstHit: process each candidate at once; tfar = -inf tells Embree the ray is done.
+// FirstHit (one ray): process each candidate at once; tfar = -inf tells Embree the ray is done.
 void occludedCallback(const RTCOccludedFunctionNArguments* args) {
     if (!args->valid[0]) return;
     auto* ctx = reinterpret_cast<GatherContext*>(args->context);
-    if (ctx->error) return;
+    RayGather& gather = ctx->rays[0];
+    if (gather.error) return;
     try {
-        const GatherRequest& req = *ctx->request;
+        const GatherRequest& req = *gather.request;
         Candidate c;
-        if (exactCandidate(*ctx, args->geometryUserPtr, args->primID, c) && req.onCandidate(req.user, c))
+        if (exactCandidate(gather, ctx->embree.instID[0], args->geometryUserPtr, args->primID, c) &&
+            req.onCandidate(req.user, c))
             RTCRayN_tfar(args->ray, args->N, 0) = -INFINITY;
     } catch (...) {
-        ctx->error = std::current_exception();
+        gather.error = std::current_exception();
         RTCRayN_tfar(args->ray, args->N, 0) = -INFINITY;
     }
 }
@@ -251,32 +266,82 @@ std::unique_ptr<EmbreeScene> buildTopLevelScene(EmbreeDevice& device, const TopL
     return out;
 }
 
+namespace {
+
+// Ray i of an N-ray packet (N = 1: a single RTCRay, whose fields lie as a packet of one) for `request`, with id i.
+void setRay(RTCRayN* ray, unsigned N, unsigned i, const GatherRequest& request) {
+    RTCRayN_org_x(ray, N, i) = request.origin.x;
+    RTCRayN_org_y(ray, N, i) = request.origin.y;
+    RTCRayN_org_z(ray, N, i) = request.origin.z;
+    RTCRayN_dir_x(ray, N, i) = request.direction.x;
+    RTCRayN_dir_y(ray, N, i) = request.direction.y;
+    RTCRayN_dir_z(ray, N, i) = request.direction.z;
+    RTCRayN_tnear(ray, N, i) = std::max(0.0f, request.tMin - (std::fabs(request.tMin) * 1e-5f + 1e-30f));
+    RTCRayN_tfar(ray, N, i) = widenedFar(request.tMax);
+    RTCRayN_time(ray, N, i) = 0.0f;
+    RTCRayN_mask(ray, N, i) = request.instanceInclusionMask & 0xFF;
+    RTCRayN_id(ray, N, i) = i;
+    RTCRayN_flags(ray, N, i) = 0;
+}
+
+// After the traversal: Closest drops the candidates that start beyond the nearest sure commit found in the end (the
+// ordered loop would skip them, TRV-2), so that a ray's candidates do not depend on the order in which Embree met
+// them (one ray or a packet); then what a callback threw is rethrown.
+void finishGather(RayGather& gather) {
+    const GatherRequest& req = *gather.request;
+    if (req.mode == GatherMode::Closest && gather.nearestCommit < INFINITY)
+        std::erase_if(*req.out, [&](const Candidate& c) { return c.key > gather.nearestCommit; });
+    if (gather.error) std::rethrow_exception(gather.error);
+}
+
+}  // namespace
+
 void gatherCandidates(const GatherRequest& request) {
+    RayGather gather;
+    gather.request = &request;
     GatherContext ctx;
     rtcInitIntersectContext(&ctx.embree);
-    ctx.request = &request;
-    ctx.error = nullptr;
-
+    ctx.rays = &gather;
     RTCRayHit rayhit;
-    RTCRay& ray = rayhit.ray;
-    ray.org_x = request.origin.x;
-    ray.org_y = request.origin.y;
-    ray.org_z = request.origin.z;
-    ray.dir_x = request.direction.x;
-    ray.dir_y = request.direction.y;
-    ray.dir_z = request.direction.z;
-    ray.tnear = std::max(0.0f, request.tMin - (std::fabs(request.tMin) * 1e-5f + 1e-30f));
-    ray.tfar = widenedFar(request.tMax);
-    ray.time = 0.0f;
-    ray.mask = request.instanceInclusionMask & 0xFF;
-    ray.id = 0;
-    ray.flags = 0;
+    setRay(reinterpret_cast<RTCRayN*>(&rayhit.ray), 1, 0, request);
     rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     RTCScene scene = static_cast<RTCScene>(request.tlas->embree().scene);
-    if (request.mode == GatherMode::FirstHit) rtcOccluded1(scene, &ctx.embree, &ray);
+    if (request.mode == GatherMode::FirstHit) rtcOccluded1(scene, &ctx.embree, &rayhit.ray);
     else rtcIntersect1(scene, &ctx.embree, &rayhit);
-    if (ctx.error) std::rethrow_exception(ctx.error);
+    finishGather(gather);
+}
+
+void gatherCandidatesPacket(std::span<const GatherRequest* const> requests, std::span<std::exception_ptr> errors) {
+    REFRAY_ASSERT(requests.size() <= size_t(kMaxGatherPacket) && errors.size() == requests.size(),
+                  "a gather packet of " << requests.size() << " rays");
+    if (requests.empty()) return;
+    std::array<RayGather, kMaxGatherPacket> rays;
+    GatherContext ctx;
+    rtcInitIntersectContext(&ctx.embree);
+    ctx.rays = rays.data();
+    alignas(64) RTCRayHit16 rayhit;
+    alignas(64) std::array<int, 16> valid{};
+    RTCRayN* ray = reinterpret_cast<RTCRayN*>(&rayhit.ray);
+    const TopLevelAS* tlas = requests[0]->tlas;
+    for (size_t i = 0; i < requests.size(); ++i) {
+        const GatherRequest& request = *requests[i];
+        REFRAY_ASSERT(request.tlas == tlas && request.mode != GatherMode::FirstHit,
+                      "a gather packet's rays share one TLAS and take no FirstHit");
+        rays[i].request = &request;
+        setRay(ray, 16, unsigned(i), request);
+        rayhit.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rayhit.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+        valid[i] = -1;
+    }
+    rtcIntersect16(valid.data(), static_cast<RTCScene>(tlas->embree().scene), &ctx.embree, &rayhit);
+    for (size_t i = 0; i < requests.size(); ++i) {
+        try {
+            finishGather(rays[i]);
+        } catch (...) {
+            errors[i] = std::current_exception();
+        }
+    }
 }
 
 }  // namespace refray::dxr::detail

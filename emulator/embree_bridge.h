@@ -9,7 +9,9 @@
 #pragma once
 
 #include <cstdint>
+#include <exception>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -92,5 +94,13 @@ struct GatherRequest {
 // exact hit at tMin <= t <= tMax; AABBs: the box touches the interval, inclusive) to the request, as its
 // mode says. Throws refray::Error if Embree reported an error, and rethrows what a callback threw.
 void gatherCandidates(const GatherRequest& request);
+
+// The most rays one gather packet takes (Embree's widest packet).
+inline constexpr int kMaxGatherPacket = 16;
+
+// gatherCandidates for up to kMaxGatherPacket requests of one TLAS, in mode All or Closest, traced as one Embree
+// packet (rtcIntersect16). Each request gets the candidates it gets alone (in the order Embree meets them, which the
+// caller orders, GEN-3). What failed for request i goes to errors[i]; the others are unaffected.
+void gatherCandidatesPacket(std::span<const GatherRequest* const> requests, std::span<std::exception_ptr> errors);
 
 }  // namespace refray::dxr::detail

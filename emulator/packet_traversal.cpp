@@ -17,6 +17,8 @@
 
 namespace refray::dxr::detail {
 
+static_assert(kMaxWaveWidth <= kMaxGatherPacket, "a wave's rays gather as one Embree packet");
+
 namespace {
 
 void emitCandidate(const ThreadState& ts, const RayState& rs, const Candidate& c) {
@@ -93,16 +95,26 @@ void runIntersectionGroup(Wave& wave, LaneMask group) {
 }  // namespace
 
 void traversePacket(Wave& wave, LaneMask lanes) {
-    LaneMask running;
+    // The rays gather their candidates as one Embree packet (each ray's candidates, order and statistics are those
+    // it gets alone).
+    std::array<GatherRay, kMaxWaveWidth> gathers;
+    std::array<int, kMaxWaveWidth> laneOf{};
+    size_t count = 0;
     for (int i : lanes) {
         WaveLane& lane = wave.lanes[size_t(i)];
-        try {
-            gatherOrderedCandidates(lane.ts, *lane.ray, lane.site);
-            lane.nextCandidate = 0;
-            running.set(i);
-        } catch (...) {
-            lane.failure = std::current_exception();
+        laneOf[count] = i;
+        gathers[count++] = GatherRay{&lane.ts, lane.ray, &lane.site, {}, nullptr};
+    }
+    gatherOrderedCandidates(std::span(gathers.data(), count));
+    LaneMask running;
+    for (size_t k = 0; k < count; ++k) {
+        WaveLane& lane = wave.lanes[size_t(laneOf[k])];
+        if (gathers[k].error) {
+            lane.failure = gathers[k].error;
+            continue;
         }
+        lane.nextCandidate = 0;
+        running.set(laneOf[k]);
     }
     RecordGroups groups;
     while (running.any()) {

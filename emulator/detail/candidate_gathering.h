@@ -1,18 +1,33 @@
-// Candidate gathering and order for one TraceRay. Internal to the emulator.
+// Candidate gathering and order for the TraceRays of a wave (one Embree packet) and for a RayQuery. Internal to the
+// emulator.
 #pragma once
 
 #include "emulator/detail/dispatch_errors.h"
 #include "emulator/detail/invocation.h"
 #include "emulator/embree_bridge.h"
 
+#include <exception>
+#include <span>
 #include <vector>
 
 namespace refray::dxr::detail {
 
-// Gathers the candidates of rs.ray in rs.tlas (Embree broad phase + exact tests; FLAG-12 skips) into
-// ts.candidates, in the order TRV-4 meets them (GEN-3). A FirstHit ray (GatherMode) has its candidates processed
-// as Embree meets them and leaves ts.candidates empty.
-void gatherOrderedCandidates(ThreadState& ts, RayState& rs, const Site& site);
+// One ray of a packet gather: its thread, ray and call site, the request the gather builds for it (whose traversal
+// shortcuts reach the ray through it), and what stopped its gather.
+struct GatherRay {
+    ThreadState* ts = nullptr;
+    RayState* rs = nullptr;
+    const Site* site = nullptr;
+    GatherRequest request;
+    std::exception_ptr error;
+};
+
+// Gathers the candidates of each of up to kMaxGatherPacket rays rs.ray in rs.tlas (Embree broad phase + exact tests;
+// FLAG-12 skips) into its ts->candidates, in the order TRV-4 meets them (GEN-3). The rays that share a TLAS traverse
+// as one Embree packet, and each gets the candidates, order and statistics it gets alone. A FirstHit ray (GatherMode)
+// traverses alone, has its candidates processed as Embree meets them and leaves its ts->candidates empty. What fails
+// for one ray goes to its `error`; the others go on.
+void gatherOrderedCandidates(std::span<GatherRay> rays);
 
 // The candidates of a RayQuery (RQ-13): every candidate, in the same order, into the query's own `out` (queries
 // and TraceRays may be live at once). No traversal shortcut: the owning shader decides for each candidate.
