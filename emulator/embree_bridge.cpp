@@ -312,6 +312,25 @@ void gatherCandidates(const GatherRequest& request) {
     finishGather(gather);
 }
 
+namespace {
+
+// The rays of `rays` (requests set) as one Embree packet of K rays (K = 4, 8 or 16), the first ones valid.
+template <unsigned K, class RayHitK, class Intersect>
+void tracePacket(GatherContext& ctx, const TopLevelAS& tlas, size_t count, Intersect intersect) {
+    alignas(64) RayHitK rayhit;
+    alignas(64) std::array<int, K> valid{};
+    RTCRayN* ray = reinterpret_cast<RTCRayN*>(&rayhit.ray);
+    for (size_t i = 0; i < count; ++i) {
+        setRay(ray, K, unsigned(i), *ctx.rays[i].request);
+        rayhit.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rayhit.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+        valid[i] = -1;
+    }
+    intersect(valid.data(), static_cast<RTCScene>(tlas.embree().scene), &ctx.embree, &rayhit);
+}
+
+}  // namespace
+
 void gatherCandidatesPacket(std::span<const GatherRequest* const> requests, std::span<std::exception_ptr> errors) {
     REFRAY_ASSERT(requests.size() <= size_t(kMaxGatherPacket) && errors.size() == requests.size(),
                   "a gather packet of " << requests.size() << " rays");
@@ -320,22 +339,28 @@ void gatherCandidatesPacket(std::span<const GatherRequest* const> requests, std:
     GatherContext ctx;
     rtcInitIntersectContext(&ctx.embree);
     ctx.rays = rays.data();
-    alignas(64) RTCRayHit16 rayhit;
-    alignas(64) std::array<int, 16> valid{};
-    RTCRayN* ray = reinterpret_cast<RTCRayN*>(&rayhit.ray);
-    const TopLevelAS* tlas = requests[0]->tlas;
+    const TopLevelAS& tlas = *requests[0]->tlas;
     for (size_t i = 0; i < requests.size(); ++i) {
-        const GatherRequest& request = *requests[i];
-        REFRAY_ASSERT(request.tlas == tlas && request.mode != GatherMode::FirstHit,
+        REFRAY_ASSERT(requests[i]->tlas == &tlas && requests[i]->mode != GatherMode::FirstHit,
                       "a gather packet's rays share one TLAS and take no FirstHit");
-        rays[i].request = &request;
-        setRay(ray, 16, unsigned(i), request);
-        rayhit.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-        rayhit.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-        valid[i] = -1;
+        rays[i].request = requests[i];
     }
-    rtcIntersect16(valid.data(), static_cast<RTCScene>(tlas->embree().scene), &ctx.embree, &rayhit);
-    for (size_t i = 0; i < requests.size(); ++i) {
+    // The narrowest packet that holds the rays.
+    const size_t n = requests.size();
+    if (n == 1) {
+        RTCRayHit rayhit;
+        setRay(reinterpret_cast<RTCRayN*>(&rayhit.ray), 1, 0, *requests[0]);
+        rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(static_cast<RTCScene>(tlas.embree().scene), &ctx.embree, &rayhit);
+    } else if (n <= 4) {
+        tracePacket<4, RTCRayHit4>(ctx, tlas, n, rtcIntersect4);
+    } else if (n <= 8) {
+        tracePacket<8, RTCRayHit8>(ctx, tlas, n, rtcIntersect8);
+    } else {
+        tracePacket<16, RTCRayHit16>(ctx, tlas, n, rtcIntersect16);
+    }
+    for (size_t i = 0; i < n; ++i) {
         try {
             finishGather(rays[i]);
         } catch (...) {
