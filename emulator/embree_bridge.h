@@ -99,8 +99,9 @@ void gatherCandidates(const GatherRequest& request);
 inline constexpr int kMaxGatherPacket = 16;
 
 // gatherCandidates for up to kMaxGatherPacket requests of one TLAS, in mode All or Closest, traced as one Embree
-// packet (rtcIntersect16). Each request gets the candidates it gets alone (in the order Embree meets them, which the
-// caller orders, GEN-3). What failed for request i goes to errors[i]; the others are unaffected.
+// packet (the narrowest of rtcIntersect1, 4, 8 and 16 that holds them). Each request gets the candidates it gets
+// alone (in the order Embree meets them, which the caller orders, GEN-3). What failed for request i goes to
+// errors[i]; the others are unaffected.
 void gatherCandidatesPacket(std::span<const GatherRequest* const> requests, std::span<std::exception_ptr> errors);
 
 }  // namespace refray::dxr::detail
