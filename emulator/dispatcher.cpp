@@ -112,7 +112,9 @@ void checkGlobalArguments(const GlobalRootArguments* globalArguments) {
 // always stop the dispatch, whatever DispatchOptions::onError says.
 void resolveRayGenerationRecord(DispatchState& ds) {
     ThreadState probe;
+    detail::LookupCache lookups;
     probe.dispatch = &ds;
+    probe.lookups = &lookups;
     const detail::Site site{ShaderStage::RayGeneration, &detail::kNoExport, 0};
     const OnError onError = ds.options.onError;
     ds.options.onError = OnError::Stop;

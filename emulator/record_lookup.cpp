@@ -42,7 +42,7 @@ bool lookupRecordChecked(ThreadState& ts, const Site& site, ProgramEntry::Kind k
                          const GpuVirtualAddressRangeAndStride& table, uint64_t index, RecordView& out,
                          const HitLookupContext* hit) {
     // A record that passed these checks for this table, index and geometry type passes them again (LookupCache).
-    LookupCache::Record& cached = ts.lookups.records[LookupCache::recordSlot(index, uint8_t(kind))];
+    LookupCache::Record& cached = ts.lookups->records[LookupCache::recordSlot(index, uint8_t(kind))];
     const uint8_t geometry = hit ? uint8_t(1 + uint8_t(hit->geometryType)) : uint8_t(0);
     if (cached.index == index && cached.kind == uint8_t(kind) && cached.geometry == geometry &&
         cached.table.StartAddress == table.StartAddress && cached.table.SizeInBytes == table.SizeInBytes &&

@@ -19,7 +19,7 @@ using detail::Invocation;
 using detail::stageError;
 
 namespace detail {
-LookupCache& lookupCache(Invocation& inv) { return inv.thread->lookups; }
+LookupCache& lookupCache(Invocation& inv) { return *inv.thread->lookups; }
 }  // namespace detail
 
 void ShaderContext::stageViolation(const char* intrinsic) const {
@@ -140,7 +140,7 @@ const uint8_t* ShaderContext::rootArgument(bool local, uint32_t parameter, size_
     // (those of one record, or the dispatch's global ones), parameter, size and type.
     const detail::ArgumentBytes arguments = detail::argumentBytes(inv_, *inv_.dispatch, local);
     const detail::LookupCache::RootArgument& cached =
-        inv_.thread->lookups.rootArguments[detail::LookupCache::rootArgumentSlot(arguments.bytes, parameter)];
+        inv_.thread->lookups->rootArguments[detail::LookupCache::rootArgumentSlot(arguments.bytes, parameter)];
     if (arguments.bytes && cached.arguments == arguments.bytes && cached.available == arguments.available &&
         cached.parameter == parameter && cached.size == size && cached.type == type.id)
         return cached.bytes;
@@ -182,7 +182,7 @@ const uint8_t* ShaderContext::rootArgumentChecked(bool local, uint32_t parameter
     if (std::memchr(written + offset, 0, size))
         stageError(inv_, "REC-7", std::string("shader reads ") + which + " root parameter " + std::to_string(parameter) +
                                       " of '" + signature->name() + "', whose bytes were never written");
-    inv_.thread->lookups.rootArguments[detail::LookupCache::rootArgumentSlot(bytes, parameter)] = {
+    inv_.thread->lookups->rootArguments[detail::LookupCache::rootArgumentSlot(bytes, parameter)] = {
         bytes, available, parameter, uint32_t(size), type.id, bytes + offset};
     return bytes + offset;
 }

@@ -10,6 +10,7 @@ Wave::Wave(DispatchState& ds) {
     for (int i = 0; i < kMaxWaveWidth; ++i) {
         WaveLane& lane = lanes[size_t(i)];
         lane.ts.dispatch = &ds;
+        lane.ts.lookups = &lookups;
         lane.ts.candidates.reserve(64);
         lane.ts.profiling = ds.options.profileStages;
         lane.ts.lane = &lane;

@@ -43,7 +43,8 @@ inline ArgumentBytes argumentBytes(const Invocation& inv, const DispatchState& d
                      : ArgumentBytes{};
 }
 
-// Lookups a dispatch repeats with the same answer, remembered per worker thread. While a dispatch runs its shader
+// Lookups a dispatch repeats with the same answer, remembered per worker thread (one cache per wave, which its lanes
+// share: ThreadState::lookups). While a dispatch runs its shader
 // tables are locked (REC-12), its global root arguments are fixed and no GPU buffer comes or goes, so a lookup that
 // succeeded once succeeds again with the same result. Only successes are kept: every failure still goes through
 // the full check and its diagnostic. Each dispatch starts with an empty cache.

@@ -71,7 +71,9 @@ struct ThreadState {
     std::vector<ExportCount> exportCounts;  // in first-call order: a handful of exports, searched linearly
     bool profiling = false;                 // DispatchOptions::profileStages
     StageClock clock;
-    LookupCache lookups;
+    // The worker thread's lookup cache: its wave's, which the wave's lanes share (they run one at a time on that
+    // thread, and a cached lookup is a fact of the dispatch, not of a launch); a probe's own.
+    LookupCache* lookups = nullptr;
 };
 
 // Charges this thread's time to `stage` while alive, when profiling; otherwise one untaken branch each way.

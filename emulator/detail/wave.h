@@ -53,6 +53,7 @@ struct Wave {
     Wave(const Wave&) = delete;
     Wave& operator=(const Wave&) = delete;
 
+    LookupCache lookups;  // the lanes' (ThreadState::lookups)
     std::array<WaveLane, kMaxWaveWidth> lanes;
     std::array<std::unique_ptr<Fiber>, kMaxWaveWidth> fibers;
     LaneMask parked;   // lanes whose TraceRay waits for the packet
