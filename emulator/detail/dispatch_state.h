@@ -44,10 +44,10 @@ inline ArgumentBytes argumentBytes(const Invocation& inv, const DispatchState& d
 }
 
 // Lookups a dispatch repeats with the same answer, remembered per worker thread (one cache per wave, which its lanes
-// share: ThreadState::lookups). While a dispatch runs its shader
-// tables are locked (REC-12), its global root arguments are fixed and no GPU buffer comes or goes, so a lookup that
-// succeeded once succeeds again with the same result. Only successes are kept: every failure still goes through
-// the full check and its diagnostic. Each dispatch starts with an empty cache.
+// share: ThreadState::lookups). While a dispatch runs its shader tables are locked (REC-12), its global root
+// arguments are fixed and no GPU buffer comes or goes, so a lookup that succeeded once succeeds again with the same
+// result. Only successes are kept: every failure still goes through the full check and its diagnostic. Each
+// dispatch starts with an empty cache.
 struct LookupCache {
     // The buffers read last, most recent first: shaders read a handful of buffers over and over.
     std::array<const GpuBuffer*, 4> buffers{};
