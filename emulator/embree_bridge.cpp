@@ -294,6 +294,17 @@ void finishGather(RayGather& gather) {
     if (gather.error) std::rethrow_exception(gather.error);
 }
 
+// `request` as one ray (ray id 0 of ctx.rays): rtcOccluded1 for FirstHit, else rtcIntersect1.
+void traceOne(GatherContext& ctx, const GatherRequest& request) {
+    RTCRayHit rayhit;
+    setRay(reinterpret_cast<RTCRayN*>(&rayhit.ray), 1, 0, request);
+    rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    RTCScene scene = static_cast<RTCScene>(request.tlas->embree().scene);
+    if (request.mode == GatherMode::FirstHit) rtcOccluded1(scene, &ctx.embree, &rayhit.ray);
+    else rtcIntersect1(scene, &ctx.embree, &rayhit);
+}
+
 }  // namespace
 
 void gatherCandidates(const GatherRequest& request) {
@@ -302,13 +313,7 @@ void gatherCandidates(const GatherRequest& request) {
     GatherContext ctx;
     rtcInitIntersectContext(&ctx.embree);
     ctx.rays = &gather;
-    RTCRayHit rayhit;
-    setRay(reinterpret_cast<RTCRayN*>(&rayhit.ray), 1, 0, request);
-    rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    RTCScene scene = static_cast<RTCScene>(request.tlas->embree().scene);
-    if (request.mode == GatherMode::FirstHit) rtcOccluded1(scene, &ctx.embree, &rayhit.ray);
-    else rtcIntersect1(scene, &ctx.embree, &rayhit);
+    traceOne(ctx, request);
     finishGather(gather);
 }
 
@@ -348,11 +353,7 @@ void gatherCandidatesPacket(std::span<const GatherRequest* const> requests, std:
     // The narrowest packet that holds the rays.
     const size_t n = requests.size();
     if (n == 1) {
-        RTCRayHit rayhit;
-        setRay(reinterpret_cast<RTCRayN*>(&rayhit.ray), 1, 0, *requests[0]);
-        rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect1(static_cast<RTCScene>(tlas.embree().scene), &ctx.embree, &rayhit);
+        traceOne(ctx, *requests[0]);
     } else if (n <= 4) {
         tracePacket<4, RTCRayHit4>(ctx, tlas, n, rtcIntersect4);
     } else if (n <= 8) {

@@ -451,6 +451,23 @@ struct ProceduralWave {
     math::Ray<L> localRay() const {
         return toLanes<math::Ray<L>>(in, [](const LaneInput<T>& l) { return l.localRay; });
     }
+    // The marching lanes' local rays through a march queue, `queue(ro, rd, count, out)` (out[k]: ray k's result),
+    // and each lane's result at its lane.
+    template <typename Hit, typename Queue>
+    std::array<Hit, kMaxWaveWidth> queued(Queue&& queue) const {
+        std::array<tvec3<T>, kMaxWaveWidth> ro{}, rd{};
+        std::array<Hit, kMaxWaveWidth> results{};
+        int count = 0;
+        for (int i : marching) {
+            ro[size_t(count)] = in[size_t(i)].localRay.origin;
+            rd[size_t(count++)] = in[size_t(i)].localRay.direction;
+        }
+        queue(ro.data(), rd.data(), count, results.data());
+        std::array<Hit, kMaxWaveWidth> byLane{};
+        count = 0;
+        for (int i : marching) byLane[size_t(i)] = results[size_t(count++)];
+        return byLane;
+    }
 };
 
 template <typename T>
@@ -550,16 +567,10 @@ void Intersection_Mandelbulb(IntersectionWave& wave, const Accuracy& accuracy) {
     const math::mandelbulb::MandelbulbParams<T> params = mandelbulbParams<T>(accuracy);
     std::array<math::mandelbulb::MandelbulbHit<T>, kMaxWaveWidth> primitiveTest{};
     if constexpr (math::kIsLanes<L>) {
-        std::array<tvec3<T>, kMaxWaveWidth> ro{}, rd{};
-        std::array<math::mandelbulb::MandelbulbHit<T>, kMaxWaveWidth> queued{};
-        int count = 0;
-        for (int i : marching) {
-            ro[size_t(count)] = in[size_t(i)].localRay.origin;
-            rd[size_t(count++)] = in[size_t(i)].localRay.direction;
-        }
-        math::mandelbulb::MandelbulbDistanceQueue<L>(ro.data(), rd.data(), count, iMax, queued.data(), params);
-        count = 0;
-        for (int i : marching) primitiveTest[size_t(i)] = queued[size_t(count++)];
+        primitiveTest = lanes.template queued<math::mandelbulb::MandelbulbHit<T>>(
+            [&](const tvec3<T>* ro, const tvec3<T>* rd, int count, math::mandelbulb::MandelbulbHit<T>* out) {
+                math::mandelbulb::MandelbulbDistanceQueue<L>(ro, rd, count, iMax, out, params);
+            });
     } else {
         primitiveTest[size_t(marching.lowest())] =
             math::mandelbulb::MandelbulbDistance(group.localRay.origin, group.localRay.direction, iMax, params);
@@ -616,16 +627,10 @@ void Intersection_Julia(IntersectionWave& wave, const Accuracy& accuracy) {
     // shader takes kMaxWaveWidth lanes a call), whose lanes take the next ray as soon as theirs ends.
     std::array<math::julia::JuliaHit<T>, kMaxWaveWidth> primitiveTest{};
     if constexpr (math::kIsLanes<L>) {
-        std::array<tvec3<T>, kMaxWaveWidth> ro{}, rd{};
-        std::array<math::julia::JuliaHit<T>, kMaxWaveWidth> queued{};
-        int count = 0;
-        for (int i : marching) {
-            ro[size_t(count)] = in[size_t(i)].localRay.origin;
-            rd[size_t(count++)] = in[size_t(i)].localRay.direction;
-        }
-        math::julia::JuliaDistanceQueue<L>(ro.data(), rd.data(), count, queued.data(), juliaParams<T>(accuracy));
-        count = 0;
-        for (int i : marching) primitiveTest[size_t(i)] = queued[size_t(count++)];
+        primitiveTest = lanes.template queued<math::julia::JuliaHit<T>>(
+            [&](const tvec3<T>* ro, const tvec3<T>* rd, int count, math::julia::JuliaHit<T>* out) {
+                math::julia::JuliaDistanceQueue<L>(ro, rd, count, out, juliaParams<T>(accuracy));
+            });
     } else {
         const LaneInput<T>& ray = lanes.group();  // a group of one lane
         primitiveTest[size_t(marching.lowest())] =
