@@ -54,14 +54,37 @@ using LaneCompareInt = std::conditional_t<sizeof(S) == 8, int64_t, std::conditio
                                           std::conditional_t<sizeof(S) == 2, int16_t, int8_t>>>;
 }  // namespace detail
 
+namespace detail {
+// m ? a : b over 32-bit lanes held in GCC vectors, where each lane of m has all its bits set or clear: for 8 lanes
+// one blend by m's sign bits (vblendvps), else a select on m != 0.
+template <class Mask, class V>
+[[gnu::always_inline]] inline V selectLanes(const Mask& m, const V& a, const V& b) {
+#if defined(__AVX__)
+    if constexpr (sizeof(V) == 32) {
+        __m256 x, y, c;
+        std::memcpy(&x, &a, sizeof(x));
+        std::memcpy(&y, &b, sizeof(y));
+        std::memcpy(&c, &m, sizeof(c));
+        const __m256 r = _mm256_blendv_ps(y, x, c);
+        V out;
+        std::memcpy(&out, &r, sizeof(out));
+        return out;
+    }
+#endif
+    return m != 0u ? a : b;
+}
+}  // namespace detail
+
 template <int N>
 struct LaneBools {
-    // 0 or 1 per lane, as wide as a float lane so that selects on float lanes vectorise.
+    // All 32 bits set or clear per lane, as wide as a float lane: what a vector comparison of float lanes gives, so
+    // that a comparison is one instruction, and a select on it one blend by the lanes' sign bits (selectLanes).
     using Storage = typename detail::LaneStorage<uint32_t, N>::type;
     Storage v;
+    static constexpr uint32_t kSet = ~0u;
 
     LaneBools() = default;
-    constexpr explicit LaneBools(bool b) : v(Storage{} + (b ? 1u : 0u)) {}
+    constexpr explicit LaneBools(bool b) : v(Storage{} + (b ? kSet : 0u)) {}
     constexpr bool operator[](int i) const { return v[i] != 0; }
 
     friend constexpr LaneBools operator&(LaneBools a, LaneBools b) {
@@ -73,7 +96,7 @@ struct LaneBools {
         return a;
     }
     friend constexpr LaneBools operator!(LaneBools a) {
-        a.v ^= 1u;
+        a.v = ~a.v;
         return a;
     }
     // && and || on masks are the lane-wise & and | (both sides are evaluated, as in a shader's SIMD code).
@@ -98,11 +121,11 @@ template <int N>
     if constexpr (N == 8) {
         __m256i x;
         std::memcpy(&x, &m.v, sizeof(x));
-        return uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_slli_epi32(x, 31))));
+        return uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(x)));
     }
 #endif
     uint32_t bits = 0;
-    for (int i = 0; i < N; ++i) bits |= (m.v[i] & 1u) << i;
+    for (int i = 0; i < N; ++i) bits |= (m.v[i] != 0u ? 1u : 0u) << i;
     return bits;
 }
 
@@ -177,10 +200,10 @@ struct Lanes {
     [[gnu::always_inline]] friend LaneBools<N> operator op(const Lanes& a, const Lanes& b) {         \
         LaneBools<N> r;                                                                              \
         if constexpr (kVector && sizeof(S) == 4) {                                                   \
-            r.v = typename LaneBools<N>::Storage(a.v op b.v) & 1u;                                   \
+            r.v = typename LaneBools<N>::Storage(a.v op b.v);                                        \
         } else {                                                                                     \
             r = LaneBools<N>(false);                                                                 \
-            forLiveLanes([&](int i) { r.v[i] = a.v[i] op b.v[i]; });                                 \
+            forLiveLanes([&](int i) { r.v[i] = a.v[i] op b.v[i] ? LaneBools<N>::kSet : 0u; });        \
         }                                                                                            \
         return r;                                                                                    \
     }
@@ -241,7 +264,7 @@ template <class S, int N>
 [[gnu::always_inline]] inline Lanes<S, N> select(const LaneBools<N>& m, const Lanes<S, N>& a, const Lanes<S, N>& b) {
     Lanes<S, N> r;
     if constexpr (Lanes<S, N>::kVector && sizeof(S) == 4) {
-        r.v = m.v != 0u ? a.v : b.v;
+        r.v = detail::selectLanes(m.v, a.v, b.v);
     } else {
         for (int i = 0; i < N; ++i) r.v[i] = m.v[i] ? a.v[i] : b.v[i];
     }
@@ -321,7 +344,7 @@ void setLane(Lanes<S, N>& x, int i, const S& value) {
 }
 template <int N>
 void setLane(LaneBools<N>& m, int i, bool value) {
-    m.v[i] = value ? 1u : 0u;
+    m.v[i] = value ? LaneBools<N>::kSet : 0u;
 }
 template <glm::length_t K, class S, int N, glm::qualifier Q>
 void setLane(glm::vec<K, Lanes<S, N>, Q>& x, int i, const glm::vec<K, S, Q>& value) {
@@ -389,7 +412,7 @@ struct ScalarOps<math::Lanes<S, N>> {
             uint32_t same = 0;
             if constexpr (sizeof(S) == 4) {
                 math::LaneBools<N> m;
-                m.v = typename math::LaneBools<N>::Storage(equal) & 1u;
+                m.v = typename math::LaneBools<N>::Storage(equal);
                 same = math::laneBits(m);
             } else {
                 for (int i = 0; i < N; ++i) same |= equal[i] ? (1u << i) : 0u;

@@ -126,8 +126,8 @@ RayExtent<L> laneExtent(const RayIn* in) {
     for (int i = 0; i < W; ++i) {
         setLane(e.tMin, i, in[i].tMin);
         setLane(e.tCurrent, i, in[i].tCurrent);
-        e.cullBackFacing.v[i] = in[i].cullBack;
-        e.cullFrontFacing.v[i] = in[i].cullFront;
+        setLane(e.cullBackFacing, i, in[i].cullBack);
+        setLane(e.cullFrontFacing, i, in[i].cullFront);
     }
     return e;
 }
