@@ -322,6 +322,22 @@ PrimitiveHit<T> IntersectPrimitive(IntersectionShader shader, uint32_t primitive
     return {};
 }
 
+// The SignedDistancePrimitive test (RaySignedDistancePrimitiveTest) for up to kMaxWaveWidth rays of one primitive
+// type over WaveLanes<float>, refilled as rays stop (math::RaySignedDistancePrimitiveTestQueue): out[k] is bit for
+// bit IntersectPrimitive<float>'s hit for ray k. What a record group of the intersection shader, and a wave call of
+// inline ray tracing, run for their lanes.
+void SignedDistanceQueue(uint32_t primitiveType, const Accuracy& accuracy, const math::SphereTraceRay<float>* rays,
+                         int count, PrimitiveHit<float>* out) {
+    using L = WaveLanes<float>;
+    [[maybe_unused]] PrecisionScope<L> scope;
+    const auto sdf = [primitiveType](const tvec3<L>& position) {
+        return math::d3d12::GetDistanceFromSignedDistancePrimitive(position, SignedDistancePrimitive(primitiveType));
+    };
+    std::array<math::SphereTraceResult<float>, kMaxWaveWidth> results;
+    math::RaySignedDistancePrimitiveTestQueue<L>(rays, count, sdf, sphereTraceParams(accuracy, 1.0f), results.data());
+    for (int k = 0; k < count; ++k) out[k] = {results[size_t(k)].hit, results[size_t(k)].thit, results[size_t(k)].normal};
+}
+
 // Inline ray tracing's IntersectPrimitive, run once over the lanes of a wave that intersect a procedural candidate
 // of the same kind (dxr::ShaderContext::callInWave, emulator/wave_call.h), as the TraceRay version's intersection
 // shaders run over a record group: the shader, primitive type and Accuracy are the call's key; each lane's ray,
@@ -372,6 +388,21 @@ void runPrimitiveCalls(std::span<void* const> lanes) {
 
 inline constexpr dxr::WaveFunction kPrimitiveCalls{runPrimitiveCalls, kWaveLanes};
 
+// The SignedDistancePrimitive calls of a wave: a whole wave's lanes a call, through SignedDistanceQueue (one lane
+// alone in float, as runPrimitiveCalls).
+void runSignedDistanceCalls(std::span<void* const> lanes) {
+    const auto call = [&lanes](size_t i) -> PrimitiveCall& { return *static_cast<PrimitiveCall*>(lanes[i]); };
+    if (lanes.size() == 1) return runPrimitiveCalls(lanes);
+    std::array<math::SphereTraceRay<float>, kMaxWaveWidth> rays;
+    std::array<PrimitiveHit<float>, kMaxWaveWidth> hits;
+    for (size_t i = 0; i < lanes.size(); ++i) rays[i] = {call(i).localRay, call(i).extent, call(i).stepScale};
+    const PrimitiveCall& first = call(0);
+    SignedDistanceQueue(first.primitiveType, *first.accuracy, rays.data(), int(lanes.size()), hits.data());
+    for (size_t i = 0; i < lanes.size(); ++i) call(i).result = hits[i];
+}
+
+inline constexpr dxr::WaveFunction kSignedDistanceCalls{runSignedDistanceCalls, kMaxWaveWidth};
+
 template <typename T>
 PrimitiveHit<T> IntersectPrimitiveInWave(const ShaderContext& ctx, IntersectionShader shader, uint32_t primitiveType,
                                          const math::Ray<T>& localRay, const math::RayExtent<T>& extent,
@@ -387,7 +418,8 @@ PrimitiveHit<T> IntersectPrimitiveInWave(const ShaderContext& ctx, IntersectionS
         call.extent = extent;
         call.elapsedTime = elapsedTime;
         call.stepScale = stepScale;
-        ctx.callInWave(kPrimitiveCalls, {&accuracy, (uint64_t(shader) << 32) | primitiveType}, &call);
+        ctx.callInWave(shader == IntersectionShader::SignedDistancePrimitive ? kSignedDistanceCalls : kPrimitiveCalls,
+                       {&accuracy, (uint64_t(shader) << 32) | primitiveType}, &call);
         return call.result;
     }
 }
@@ -841,18 +873,40 @@ void IntersectionShaderOf(IntersectionWave& wave, IntersectionShader shader, con
         return l;
     });
     if (wave.active().empty()) return;
-    const math::LiveLanes live(wave.active().bits(), 0);  // duplicated inactive lanes skip libm's calls
-    const auto localRay = toLanes<math::Ray<L>>(in, [](const LaneInput& l) { return l.localRay; });
-    const auto extent = toLanes<math::RayExtent<L>>(in, [](const LaneInput& l) { return l.extent; });
-    const L elapsedTime = toLanes<L>(in, [](const LaneInput& l) { return l.elapsedTime; });
-    const L stepScale = toLanes<L>(in, [](const LaneInput& l) { return l.stepScale; });
-    const PrimitiveHit<L> test = IntersectPrimitive<L>(shader, in[size_t(wave.active().lowest())].primitiveType, localRay,
-                                                       extent, elapsedTime, stepScale, accuracy);
+    const uint32_t primitiveType = in[size_t(wave.active().lowest())].primitiveType;
+    std::array<PrimitiveHit<T>, kMaxWaveWidth> hits{};  // each lane's
+    if constexpr (math::kIsLanes<L>) {
+        if (shader == IntersectionShader::SignedDistancePrimitive) {
+            // The sphere tracing of all the group's lanes (up to a wave's) through one queue.
+            std::array<math::SphereTraceRay<T>, kMaxWaveWidth> rays;
+            std::array<PrimitiveHit<T>, kMaxWaveWidth> queued;
+            int count = 0;
+            for (int i : wave.active()) {
+                const LaneInput& l = in[size_t(i)];
+                rays[size_t(count++)] = {l.localRay, l.extent, l.stepScale};
+            }
+            SignedDistanceQueue(primitiveType, accuracy, rays.data(), count, queued.data());
+            count = 0;
+            for (int i : wave.active()) hits[size_t(i)] = queued[size_t(count++)];
+        }
+    }
+    if (!math::kIsLanes<L> || shader != IntersectionShader::SignedDistancePrimitive) {
+        const math::LiveLanes live(wave.active().bits(), 0);  // duplicated inactive lanes skip libm's calls
+        const auto localRay = toLanes<math::Ray<L>>(in, [](const LaneInput& l) { return l.localRay; });
+        const auto extent = toLanes<math::RayExtent<L>>(in, [](const LaneInput& l) { return l.extent; });
+        const L elapsedTime = toLanes<L>(in, [](const LaneInput& l) { return l.elapsedTime; });
+        const L stepScale = toLanes<L>(in, [](const LaneInput& l) { return l.stepScale; });
+        const PrimitiveHit<L> test =
+            IntersectPrimitive<L>(shader, primitiveType, localRay, extent, elapsedTime, stepScale, accuracy);
+        for (int i : wave.active()) hits[size_t(i)] = {math::lane(test.hit, i), math::lane(test.thit, i),
+                                                       math::lane(test.normal, i)};
+    }
     wave.forEachLane([&](int i, ShaderContext& ctx) {
-        if (!math::lane(test.hit, i)) return;
+        const PrimitiveHit<T>& hit = hits[size_t(i)];
+        if (!hit.hit) return;
         const ProceduralPrimitiveAttributes attr{
-            vec3(NormalToWorld(ctx.ObjectToWorld3x4(), in[size_t(i)].aabbAttribute, math::lane(test.normal, i)))};
-        wave.ReportHit(i, float(math::lane(test.thit, i)), /*hitKind*/ 0, attr);
+            vec3(NormalToWorld(ctx.ObjectToWorld3x4(), in[size_t(i)].aabbAttribute, hit.normal))};
+        wave.ReportHit(i, float(hit.thit), /*hitKind*/ 0, attr);
     });
 }
 
@@ -933,7 +987,8 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
             });
         }),
         ReportHitEnd::Return);
-    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("MyIntersectionShader_SignedDistancePrimitive", kWaveLanes,
+    // The sphere tracing takes a whole wave's lanes a call, refilling its WaveLanes from a queue (SignedDistanceQueue).
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("MyIntersectionShader_SignedDistancePrimitive", kMaxWaveWidth,
         in([accuracy](IntersectionWave& wave) {
             withLaneType<T>(wave, [&]<class L>() {
                 IntersectionShaderOf<T, L>(wave, IntersectionShader::SignedDistancePrimitive, accuracy);

@@ -5,10 +5,13 @@
 // bit for bit the scalar float result for ray i.
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 
 #include "procedural/accuracy.h"
 #include "procedural/math/hlsl.h"
+#include "procedural/math/march_queue.h"
 #include "procedural/math/ray.h"
 
 namespace refray::procedural::math {
@@ -272,6 +275,41 @@ struct SphereTraceResult {
     LaneUint<T> steps = LaneUint<T>(0);  // loop iterations taken
 };
 
+// A sphere tracing's state between steps: where the ray stands and what it found so far.
+template <typename T>
+struct SphereTraceMarch {
+    T t = T(0);
+    SphereTraceResult<T> result;
+};
+
+// One pass of RaySignedDistancePrimitiveTest's loop body for the rays of `running`, as iteration `i` (1-based; the
+// loop's `i++ < maxSteps` is the caller's): a ray beyond RayTCurrent leaves `running`, as does a ray whose hit is
+// accepted.
+template <typename T, class Sdf>
+void sphereTraceStep(const Ray<T>& ray, const RayExtent<T>& extent, Sdf& sdf, const SphereTraceParams<T>& params,
+                     const LaneUint<T>& i, SphereTraceMarch<T>& m, LaneMask<T>& running) {
+    running = running && m.t <= extent.tCurrent;  // PORT: the loop's `&& t <= RayTCurrent()`, per ray
+    if (!anyLane(running)) return;
+    const LiveLanes live(running);
+    SphereTraceResult<T>& result = m.result;
+    result.steps = select(running, i, result.steps);
+    const vec3<T> position = ray.origin + m.t * ray.direction;
+    const T distance = sdf(position);
+
+    const LaneMask<T> candidate = running && distance <= params.threshold * m.t;
+    if (anyLane(candidate)) {
+        const vec3<T> hitSurfaceNormal = sdCalculateNormal(position, sdf, params.normalOffset);
+        const LaneMask<T> accepted = candidate && IsAValidHit(ray, m.t, hitSurfaceNormal, extent);
+        // if (IsAValidHit(...)) { ...; return true; }
+        result.hit = result.hit || accepted;
+        result.thit = select(accepted, m.t, result.thit);
+        result.normal = select(accepted, hitSurfaceNormal, result.normal);
+        result.position = select(accepted, position, result.position);
+        running = running && !accepted;
+    }
+    m.t = select(running, m.t + params.stepScale * distance, m.t);  // t += stepScale * distance
+}
+
 // PORT: RayTMin()/RayTCurrent()/RayFlags() come in as `extent` (RayTCurrent cannot change inside
 // the loop, which never calls ReportHit); the HLSL `out` thit/attr become the result struct.
 // t starts at extent.tMin; at most maxSteps iterations while t <= extent.tCurrent:
@@ -281,36 +319,77 @@ struct SphereTraceResult {
 // PORT: for lanes, `running` holds the rays still in the loop: the loop condition and the `return` clear a ray's
 // bit, every step is computed for all lanes and kept (select) in the running ones only, and the loop ends when no
 // ray runs (the step count is uniform). For a scalar T the mask is the loop's own control flow: the same operations
-// in the same order.
+// in the same order. PORT: the loop body is sphereTraceStep, so that RaySignedDistancePrimitiveTestQueue runs the
+// same steps for a queue of rays.
 template <typename T, class Sdf>
 SphereTraceResult<T> RaySignedDistancePrimitiveTest(const Ray<T>& ray, const RayExtent<T>& extent, Sdf&& sdf,
                                                     const SphereTraceParams<T>& params = {}) {
-    SphereTraceResult<T> result;
-    T t = extent.tMin;
+    SphereTraceMarch<T> m;
+    m.t = extent.tMin;
     LaneMask<T> running = allLanesSet<T>();
     std::uint32_t i = 0;
     while (i++ < params.maxSteps) {
-        running = running && t <= extent.tCurrent;  // PORT: the loop's `&& t <= RayTCurrent()`, per ray
+        sphereTraceStep(ray, extent, sdf, params, LaneUint<T>(i), m, running);
         if (!anyLane(running)) break;
-        const LiveLanes live(running);
-        result.steps = select(running, LaneUint<T>(i), result.steps);
-        const vec3<T> position = ray.origin + t * ray.direction;
-        const T distance = sdf(position);
-
-        const LaneMask<T> candidate = running && distance <= params.threshold * t;
-        if (anyLane(candidate)) {
-            const vec3<T> hitSurfaceNormal = sdCalculateNormal(position, sdf, params.normalOffset);
-            const LaneMask<T> accepted = candidate && IsAValidHit(ray, t, hitSurfaceNormal, extent);
-            // if (IsAValidHit(...)) { ...; return true; }
-            result.hit = result.hit || accepted;
-            result.thit = select(accepted, t, result.thit);
-            result.normal = select(accepted, hitSurfaceNormal, result.normal);
-            result.position = select(accepted, position, result.position);
-            running = running && !accepted;
-        }
-        t = select(running, t + params.stepScale * distance, t);  // t += stepScale * distance
     }
-    return result;
+    return m.result;
+}
+
+// One ray of a sphere-tracing queue: its local ray, its extent and its material's stepScale.
+template <typename S>
+struct SphereTraceRay {
+    Ray<S> ray;
+    RayExtent<S> extent;
+    S stepScale = S(1);
+};
+
+// RaySignedDistancePrimitiveTest for `count` (at most kMaxMarchQueue) rays in S over the lanes of L = Lanes<S, N>,
+// refilled from the queue as rays stop (march_queue.h): out[k] is bit for bit
+// RaySignedDistancePrimitiveTest(rays[k].ray, rays[k].extent, sdf, params with rays[k].stepScale) in S. `sdf` runs
+// over L; params' threshold, maxSteps and normalOffset are every ray's (its stepScale is not read).
+// PORT: not in the HLSL; a GPU runs a wave's sphere tracing in its lanes, each lane until its own ray ends.
+template <class L, class Sdf, class S = typename L::Scalar>
+void RaySignedDistancePrimitiveTestQueue(const SphereTraceRay<S>* rays, int count, Sdf&& sdf,
+                                         const SphereTraceParams<S>& params, SphereTraceResult<S>* out) {
+    std::array<SphereTraceMarch<S>, kMaxMarchQueue> march{};
+    for (int k = 0; k < count; ++k) march[size_t(k)].t = rays[k].extent.tMin;  // where a ray that never steps stays
+    Ray<L> ray;
+    RayExtent<L> extent;
+    SphereTraceParams<L> laneParams;
+    laneParams.threshold = L(params.threshold);
+    laneParams.normalOffset = L(params.normalOffset);
+    SphereTraceMarch<L> m;
+    LaneUint<L> i(0u);  // each lane's iteration, as the one-ray loop counts it
+    marchQueue<L>(
+        count, int(std::min<std::uint32_t>(params.maxSteps, std::uint32_t(1) << 30)), [](int) { return true; },
+        [&](int j, int k) {
+            const SphereTraceRay<S>& r = rays[k];
+            setLane(ray, j, r.ray);
+            setLane(extent, j, r.extent);
+            setLane(laneParams.stepScale, j, r.stepScale);
+            const SphereTraceMarch<S>& from = march[size_t(k)];
+            setLane(m.t, j, from.t);
+            setLane(m.result.hit, j, bool(from.result.hit));
+            setLane(m.result.thit, j, from.result.thit);
+            setLane(m.result.normal, j, from.result.normal);
+            setLane(m.result.position, j, from.result.position);
+            setLane(m.result.steps, j, from.result.steps);
+            setLane(i, j, from.result.steps);
+        },
+        [&](LaneMask<L>& running) {
+            i = select(running, i + LaneUint<L>(1u), i);
+            sphereTraceStep(ray, extent, sdf, laneParams, i, m, running);
+        },
+        [&](int j, int k) {
+            SphereTraceMarch<S>& to = march[size_t(k)];
+            to.t = lane(m.t, j);
+            to.result.hit = lane(m.result.hit, j);
+            to.result.thit = lane(m.result.thit, j);
+            to.result.normal = lane(m.result.normal, j);
+            to.result.position = lane(m.result.position, j);
+            to.result.steps = lane(m.result.steps, j);
+        });
+    for (int k = 0; k < count; ++k) out[k] = march[size_t(k)].result;
 }
 
 }  // namespace refray::procedural::math

@@ -490,26 +490,38 @@ void Intersection_Pacman(IntersectionWave& wave, const Accuracy& accuracy) {
     const LaneMask marching = lanes.marching;
     if (marching.empty()) return;
     const LaneInput<T>& group = lanes.group();
-    const math::Ray<L> localRay = lanes.template localRay<L>();
-    const auto extent = toLanes<math::RayExtent<L>>(in, [](const LaneInput<T>& l) { return l.extent; });
     const auto primitiveType = SignedDistancePrimitive(group.aabbCB.primitiveType);
 
     const L mouth = L(math::pacman::PacmanMouthInterpolant(T(group.sceneCB.elapsedTime)));
     // PORT: the march's threshold, step limit and normal offset come from the library's Accuracy.
-    const math::SphereTraceParams<L> params = sphereTraceParams(accuracy, L(T(group.stepScale)));
+    const math::SphereTraceParams<T> params = sphereTraceParams(accuracy, T(group.stepScale));
     const auto sdf = [primitiveType, mouth](const tvec3<L>& p) {
         return GetDistanceFromSignedDistancePrimitive(p, primitiveType, mouth);
     };
-    const math::SphereTraceResult<L> primitiveTest = math::RaySignedDistancePrimitiveTest(localRay, extent, sdf, params);
+    // PORT: the marching lanes' sphere tracing runs through one queue over L's lanes (a whole wave's lanes a call).
+    std::array<math::SphereTraceResult<T>, kMaxWaveWidth> primitiveTest{};
+    if constexpr (math::kIsLanes<L>) {
+        std::array<math::SphereTraceRay<T>, kMaxWaveWidth> rays;
+        std::array<math::SphereTraceResult<T>, kMaxWaveWidth> results;
+        int count = 0;
+        for (int i : marching) rays[size_t(count++)] = {in[size_t(i)].localRay, in[size_t(i)].extent, params.stepScale};
+        math::RaySignedDistancePrimitiveTestQueue<L>(rays.data(), count, sdf, params, results.data());
+        count = 0;
+        for (int i : marching) primitiveTest[size_t(i)] = results[size_t(count++)];
+    } else {
+        primitiveTest[size_t(marching.lowest())] =
+            math::RaySignedDistancePrimitiveTest(group.localRay, group.extent, sdf, params);  // a group of one lane
+    }
 
     // H1: thit is in normalised local units, compared with and reported as if it were world t.
     wave.forEachLane([&](int i, ShaderContext& ctx) {
         if (!marching.test(i)) return;
-        const T thit = math::lane(primitiveTest.thit, i);
-        if (!(math::lane(primitiveTest.hit, i) && thit < T(in[size_t(i)].extent.tCurrent))) return;
-        const tvec3<T> normal = math::lane(primitiveTest.normal, i);
+        const math::SphereTraceResult<T>& test = primitiveTest[size_t(i)];
+        const T thit = test.thit;
+        if (!(test.hit && thit < T(in[size_t(i)].extent.tCurrent))) return;
+        const tvec3<T> normal = test.normal;
         ProceduralPrimitiveAttributes attr = kInitialAttributes;
-        attr.color = vec4(math::pacman::PacmanHitColor(normal, math::lane(primitiveTest.position, i)));
+        attr.color = vec4(math::pacman::PacmanHitColor(normal, test.position));
         attr.normal = vec3(NormalToWorld(ctx, normal));
         wave.ReportHit(i, float(thit), /*hitKind*/ 0, attr);
     });
@@ -716,7 +728,8 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
         in([traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
             ClosestHit_Julia<T>(ctx, traceRay, accuracy, payload, attr);
         }));
-    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("Intersection_Pacman", kWaveLanes, in([accuracy](IntersectionWave& wave) {
+    // Pac-man: a whole wave's lanes a call, for RaySignedDistancePrimitiveTestQueue's refilled lanes.
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("Intersection_Pacman", kMaxWaveWidth, in([accuracy](IntersectionWave& wave) {
             withLaneType<T>(wave, [&]<class L>() { Intersection_Pacman<T, L>(wave, accuracy); });
         }),
         ReportHitEnd::Return);

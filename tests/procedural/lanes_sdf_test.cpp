@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -234,6 +235,63 @@ TEST(LanesSdf, SphereTracingMatchesScalarPerLane) {
             stats.expectMixed(sdf.name);
         }
     }
+}
+
+TEST(LanesSdf, SphereTracingQueuesGiveEachRayItsScalarResult) {
+    // RaySignedDistancePrimitiveTestQueue refills its W lanes from a queue of up to 16 rays: every ray's result (hit,
+    // t, normal, position, step count) is bit for bit its one-ray RaySignedDistancePrimitiveTest, for every queue
+    // length 1..16, with each ray's own stepScale, rays that hit, miss, start beyond RayTCurrent, run out of steps
+    // (the coarse and one-step accuracies), and rays of NaN and infinite values.
+    std::vector<RayIn> rays = makeRays(0x9E5, 16 * 10, 0.5f, 1.0f);
+    Rng rng{0x77};
+    for (int i = 0; i < 24; ++i) rays.insert(rays.begin() + 7 * i, garbageRay(rng, i));
+    for (RayIn& r : rays)
+        if (std::isnan(r.param) || r.param > 2.0f) r.param = 0.75f;  // the stepScale: a material's
+    Accuracy coarse;
+    coarse.stepsFactor = 0.05;  // 26 steps: some rays run out of steps
+    coarse.thresholdFactor = 4.0;
+    coarse.normalEpsilonFactor = 3.0;
+    Accuracy oneStep;
+    oneStep.stepsFactor = 1e-9;  // scaledSteps gives 1
+    int hits = 0, misses = 0, queues = 0;
+    for (const NamedSdf& sdf : kSdfs) {
+        for (const Accuracy& accuracy : {Accuracy{}, coarse, oneStep}) {
+            const SphereTraceParams<float> params = sphereTraceParams(accuracy, 1.0f);
+            size_t first = 0;
+            for (int count = 1; first < rays.size(); count = count % kMaxMarchQueue + 1) {
+                const int n = int(std::min<size_t>(size_t(count), rays.size() - first));
+                std::vector<SphereTraceRay<float>> queue;
+                for (int k = 0; k < n; ++k) {
+                    const RayIn& r = rays[first + size_t(k)];
+                    queue.push_back({scalarRay(r), scalarExtent(r), r.param});
+                }
+                std::vector<SphereTraceResult<float>> got(static_cast<size_t>(n));
+                RaySignedDistancePrimitiveTestQueue<L>(queue.data(), n, sdf.lanes, params, got.data());
+                ++queues;
+                for (int k = 0; k < n; ++k) {
+                    const RayIn& r = rays[first + size_t(k)];
+                    const SphereTraceResult<float> want = RaySignedDistancePrimitiveTest(
+                        scalarRay(r), scalarExtent(r), sdf.scalar, sphereTraceParams(accuracy, r.param));
+                    const SphereTraceResult<float>& g = got[size_t(k)];
+                    const std::string what = std::string(sdf.name) + " ray " + std::to_string(first + size_t(k)) +
+                                             " of a queue of " + std::to_string(n) + ", " +
+                                             std::to_string(params.maxSteps) + " steps";
+                    EXPECT_EQ(want.hit, g.hit) << what;
+                    EXPECT_EQ(bits(want.thit), bits(g.thit)) << what;
+                    for (int c = 0; c < 3; ++c) {
+                        EXPECT_EQ(bits(want.normal[c]), bits(g.normal[c])) << what << " normal";
+                        EXPECT_EQ(bits(want.position[c]), bits(g.position[c])) << what << " position";
+                    }
+                    EXPECT_EQ(want.steps, g.steps) << what;
+                    (want.hit ? hits : misses)++;
+                }
+                first += size_t(n);
+            }
+        }
+    }
+    EXPECT_GT(hits, 100);
+    EXPECT_GT(misses, 100);
+    EXPECT_GT(queues, 100);
 }
 
 TEST(LanesSdf, MetaballsMatchScalarPerLane) {
