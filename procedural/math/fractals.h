@@ -49,13 +49,18 @@ T mdist(const vec3<T>& p, vec4<T>& resColor, int iterations = kIterations) {
         const LiveLanes live(running);
         // The non-PERFORMANCE branch (the live one). Exponents 7 and 8 are not the literal 2, so
         // DXC lowers both pows to exp2(y*log2(x)).
-        const T dzNext = T(8) * hlsl::pow(hlsl::sqrt(m), T(7)) * dz + T(1);
-
+        // PORT: pow(sqrt(m), 7) and pow(r, 8) share their log2, and sin(b) is computed once, as a compiler's common
+        // subexpressions: r = length(w) = sqrt(dot(w, w)) is sqrt(m) bit for bit (m is dot(w, w)), and each
+        // instruction is a function of its operands, so every value is the HLSL's.
         const T r = hlsl::length(w);
+        const T log2r = hlsl::log2(r);
+        const T dzNext = T(8) * hlsl::exp2(T(7) * log2r) * dz + T(1);  // 8*pow(sqrt(m), 7)*dz + 1
+
         const T b = T(8) * hlsl::acos(w.y / r);
         const T a = T(8) * hlsl::atan2(w.x, w.z);
-        const vec3<T> wNext = p + hlsl::pow(r, T(8)) *
-                                      vec3<T>(hlsl::sin(b) * hlsl::sin(a), hlsl::cos(b), hlsl::sin(b) * hlsl::cos(a));
+        const T sinB = hlsl::sin(b);
+        const vec3<T> wNext = p + hlsl::exp2(T(8) * log2r) *  // pow(r, 8)
+                                      vec3<T>(sinB * hlsl::sin(a), hlsl::cos(b), sinB * hlsl::cos(a));
 
         const vec4<T> trapNext = hlsl::min(trap, vec4<T>(hlsl::abs(wNext), m));
 
