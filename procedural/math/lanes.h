@@ -400,7 +400,28 @@ struct ScalarOps<math::Lanes<S, N>> {
     // pow where every live lane holds one base and one exponent (the fractal pyramid's pow(2, -n)): once, the bits
     // of each lane's exp2(y * log2(x)); the lanes that are not live keep x, as mapLive leaves them.
     static bool powOnce(const L& x, const L& y, L& r) {
-        return once(r, [](S a, S b) { return hlsl::pow(a, b); }, x, y);
+        return once(r, [](S a, S b) { return lastPow(a, b); }, x, y);
+    }
+    // pow(a, b) in S; for float the last base, exponent, result and floating-point mode (MXCSR: the denormal
+    // flushing PrecisionScope sets) are kept per thread, as the fractal pyramid's march asks for pow(2, -4) at
+    // every step: a kept result is the bits the call gives.
+    static S lastPow(S a, S b) {
+#if REFRAY_HAS_MXCSR
+        if constexpr (std::is_same_v<S, float>) {
+            struct Last {
+                uint32_t a = 0, b = 0, mode = 0;
+                float result = 0.0f;
+                bool valid = false;
+            };
+            static thread_local Last last;
+            const uint32_t abits = std::bit_cast<uint32_t>(a), bbits = std::bit_cast<uint32_t>(b);
+            const uint32_t mode = _mm_getcsr() & ~0x3Fu;  // the control bits, not the sticky exception flags
+            if (!(last.valid && last.a == abits && last.b == bbits && last.mode == mode))
+                last = {abits, bbits, mode, hlsl::pow(a, b), true};
+            return last.result;
+        }
+#endif
+        return hlsl::pow(a, b);
     }
     // Whether every lane of `live` holds lane `first`'s bits (SIMD types only: a comparison and a mask test).
     static bool uniformBits(uint32_t live, int first, const L& x) {

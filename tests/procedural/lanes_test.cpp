@@ -11,6 +11,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
+#include <utility>
 #include <random>
 #include <vector>
 
@@ -89,6 +91,42 @@ TEST(Lanes, SelectAndMasksWorkLaneByLane) {
     for (int i = 0; i < W; ++i) EXPECT_EQ(s.v[i], i < 4 ? float(i) : -1.0f);
     EXPECT_EQ(math::select(true, 2.0f, 3.0f), 2.0f);  // the scalar form is the plain conditional
     EXPECT_FALSE(math::anyLane(a > L(100.0f)));
+}
+
+// pow over lanes that all hold one base and one exponent is computed once and kept per thread (lastPow, for the
+// fractal pyramid's pow(2, -n) at every march step): whatever came before, each result is the scalar pow of its
+// operands in the floating-point mode of the moment, denormal flushing included.
+TEST(Lanes, UniformPowIsTheScalarPowWhateverCameBefore) {
+    const auto scalarPow = [](float a, float b) {
+        volatile float x = a, y = b;  // no constant folding
+        return hlsl::pow(float(x), float(y));
+    };
+    const std::pair<float, float> operands[] = {{2.0f, -4.0f}, {2.0f, -130.0f}, {3.0f, 0.5f}, {2.0f, -4.0f},
+                                                {2.0f, -130.0f}, {0.0f, 2.0f}, {-1.0f, 2.0f}, {2.0f, -130.0f}};
+    bool modesDiffer = false;
+    for (int pass = 0; pass < 2; ++pass) {
+        for (const auto& [a, b] : operands) {
+            for (const bool flush : {true, false, true, false}) {  // kept under one mode, asked under the other
+                std::optional<hlsl::ScopedFlushDenormals> ftz;
+                if (flush) ftz.emplace();
+                const float want = scalarPow(a, b);
+                const L got = hlsl::pow(L(a), L(b));
+                for (int i = 0; i < W; ++i)
+                    EXPECT_EQ(bitsOf(want), bitsOf(got.v[i])) << "pow(" << a << ", " << b << ") lane " << i
+                                                              << (flush ? ", denormals flushed" : "");
+                if (flush && hlsl::ScopedFlushDenormals::active()) {
+                    ftz.reset();
+                    modesDiffer = modesDiffer || bitsOf(scalarPow(a, b)) != bitsOf(want);
+                }
+            }
+        }
+    }
+    if (hlsl::ScopedFlushDenormals::active()) {
+        EXPECT_TRUE(modesDiffer) << "no operands whose pow the mode changes";
+    }
+    // Lanes that hold different operands each get their own scalar pow.
+    const L mixed = hlsl::pow(L::generate([](int i) { return 1.5f + float(i); }), L(-4.0f));
+    for (int i = 0; i < W; ++i) EXPECT_EQ(bitsOf(mixed.v[i]), bitsOf(scalarPow(1.5f + float(i), -4.0f)));
 }
 
 }  // namespace
