@@ -153,7 +153,10 @@ MetaballsHit<T> RayMetaballsIntersectionTest(const Ray<T>& ray, const RayExtent<
     T t = tmin;
     const T minTStep = (tmax - tmin) / static_cast<T>(MAX_STEPS / 1);
     std::uint32_t iStep = 0;
-    LaneMask<T> running = allLanesSet<T>();
+    // PORT: a ray that misses every ball (tmin = +inf after the clip, H8; or TMin = +inf) samples only infinite and
+    // NaN positions, whose potential is 0 (`distance <= radius` fails), so no sample can be a candidate: it leaves
+    // the loop at once with the result it would have after MAX_STEPS samples (no hit), instead of taking them.
+    LaneMask<T> running = !(tmin == infinityOf<T>());
 
     while (iStep++ < MAX_STEPS && anyLane(running)) {
         const LiveLanes live(running);

@@ -3,6 +3,7 @@
 #include "procedural/math/metaballs.h"
 
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -85,6 +86,39 @@ TEST(MetaballMarch, H8RayMissingEveryBallReportsNothing) {
     EXPECT_TRUE(std::isinf(tmin) && tmin > 0);
     EXPECT_TRUE(std::isinf(tmax) && tmax < 0);
     EXPECT_FALSE(RayMetaballsIntersectionTest(ray, RayExtent<float>{0, 100, true, false}, 0.0f).hit);
+}
+
+// RayMetaballsIntersectionTest lets a ray with tmin = +inf leave its loop at once. That is sound only if none of the
+// 128 samples the HLSL takes for it can be a candidate: replay them here, for rays that miss every ball in every
+// direction class (axis-parallel and zero components make NaN positions), with TMin = +inf too, and for animated
+// balls; every sample's potential must stay below the 0.25 threshold (it is 0).
+TEST(MetaballMarch, ARayWithAnInfiniteSpanStartSamplesNoPotential) {
+    const float inf = std::numeric_limits<float>::infinity();
+    int replayed = 0;
+    for (int i = 0; i < 400; ++i) {
+        const float a = float(i) * 0.7853f, b = float(i % 13) * 0.31f;
+        vec3 d(std::cos(a) * std::cos(b), std::sin(b), std::sin(a) * std::cos(b));
+        if (i % 5 == 0) d[i % 3] = 0.0f;        // a zero component: 0 * inf is NaN
+        if (i % 7 == 0) d = vec3(0, 0, 1) * float(1 - 2 * (i % 2));
+        const vec3 o = vec3(std::sin(float(i)), std::cos(float(i) * 1.3f), std::sin(float(i) * 0.7f)) * 3.0f;
+        const RayExtent<float> extent{i % 11 == 0 ? inf : 0.0f, i % 11 == 0 ? inf : 100.0f, false, false};
+        const Ray<float> ray{o, d};
+        const Metaballs<float> blobs = InitializeAnimatedMetaballs(float(i % 12), 12.0f);
+        float tmin = 0, tmax = 0;
+        FindIntersectingMetaballs(ray, extent, tmin, tmax, blobs);
+        if (tmin != inf) continue;
+        ++replayed;
+        // The HLSL's loop, sample by sample.
+        float t = tmin;
+        const float minTStep = (tmax - tmin) / 128.0f;
+        for (int step = 0; step < 128; ++step) {
+            const vec3 position = ray.origin + t * ray.direction;
+            EXPECT_FALSE(CalculateMetaballsPotential(position, blobs) >= 0.25f) << "ray " << i << " sample " << step;
+            t = t + minTStep;
+        }
+        EXPECT_FALSE(RayMetaballsIntersectionTest(ray, extent, float(i % 12)).hit) << "ray " << i;
+    }
+    EXPECT_GT(replayed, 100);
 }
 
 TEST(MetaballMarch, SpanIsClippedToTCurrent) {
