@@ -48,6 +48,22 @@ Result toLanes(const std::array<Input, dxr::kMaxWaveWidth>& in, Get get) {
     return lanes;
 }
 
+// The lanes of `lanes` through a march queue: item k of the queue is get(in[i]) for the k-th lane i of `lanes` (in
+// lane order), `queue(items, count, results)` fills results[k] for item k, and each lane's result lands at its lane
+// (the other lanes' stay Result{}).
+template <class Result, class Input, class Get, class Queue>
+std::array<Result, dxr::kMaxWaveWidth> throughQueue(dxr::LaneMask lanes, const std::array<Input, dxr::kMaxWaveWidth>& in,
+                                                    Get get, Queue&& queue) {
+    std::array<decltype(get(in[0])), dxr::kMaxWaveWidth> items{};
+    std::array<Result, dxr::kMaxWaveWidth> results{}, byLane{};
+    int count = 0;
+    for (int i : lanes) items[size_t(count++)] = get(in[size_t(i)]);
+    queue(items.data(), count, results.data());
+    count = 0;
+    for (int i : lanes) byLane[size_t(i)] = results[size_t(count++)];
+    return byLane;
+}
+
 // Calls f.template operator()<L>() with the lane type a record group's math runs in: T itself for a group of one lane
 // (nothing to keep in step, and no lanes to pay for), WaveLanes<T> otherwise. A scalar type without SIMD
 // instructions (PerturbedFloat, whose every operation is a hash and a rounding) runs each lane alone in T, and so does

@@ -874,23 +874,17 @@ void IntersectionShaderOf(IntersectionWave& wave, IntersectionShader shader, con
     });
     if (wave.active().empty()) return;
     const uint32_t primitiveType = in[size_t(wave.active().lowest())].primitiveType;
-    std::array<PrimitiveHit<T>, kMaxWaveWidth> hits{};  // each lane's
-    if constexpr (math::kIsLanes<L>) {
-        if (shader == IntersectionShader::SignedDistancePrimitive) {
-            // The sphere tracing of all the group's lanes (up to a wave's) through one queue.
-            std::array<math::SphereTraceRay<T>, kMaxWaveWidth> rays;
-            std::array<PrimitiveHit<T>, kMaxWaveWidth> queued;
-            int count = 0;
-            for (int i : wave.active()) {
-                const LaneInput& l = in[size_t(i)];
-                rays[size_t(count++)] = {l.localRay, l.extent, l.stepScale};
-            }
-            SignedDistanceQueue(primitiveType, accuracy, rays.data(), count, queued.data());
-            count = 0;
-            for (int i : wave.active()) hits[size_t(i)] = queued[size_t(count++)];
+    // Each lane's hit.
+    const std::array<PrimitiveHit<T>, kMaxWaveWidth> hits = [&] {
+        if constexpr (math::kIsLanes<L>) {
+            if (shader == IntersectionShader::SignedDistancePrimitive)  // all the group's lanes through one queue
+                return throughQueue<PrimitiveHit<T>>(
+                    wave.active(), in,
+                    [](const LaneInput& l) { return math::SphereTraceRay<T>{l.localRay, l.extent, l.stepScale}; },
+                    [&](const math::SphereTraceRay<T>* rays, int count, PrimitiveHit<T>* out) {
+                        SignedDistanceQueue(primitiveType, accuracy, rays, count, out);
+                    });
         }
-    }
-    if (!math::kIsLanes<L> || shader != IntersectionShader::SignedDistancePrimitive) {
         const math::LiveLanes live(wave.active().bits(), 0);  // duplicated inactive lanes skip libm's calls
         const auto localRay = toLanes<math::Ray<L>>(in, [](const LaneInput& l) { return l.localRay; });
         const auto extent = toLanes<math::RayExtent<L>>(in, [](const LaneInput& l) { return l.extent; });
@@ -898,9 +892,11 @@ void IntersectionShaderOf(IntersectionWave& wave, IntersectionShader shader, con
         const L stepScale = toLanes<L>(in, [](const LaneInput& l) { return l.stepScale; });
         const PrimitiveHit<L> test =
             IntersectPrimitive<L>(shader, primitiveType, localRay, extent, elapsedTime, stepScale, accuracy);
-        for (int i : wave.active()) hits[size_t(i)] = {math::lane(test.hit, i), math::lane(test.thit, i),
-                                                       math::lane(test.normal, i)};
-    }
+        std::array<PrimitiveHit<T>, kMaxWaveWidth> byLane{};
+        for (int i : wave.active())
+            byLane[size_t(i)] = {math::lane(test.hit, i), math::lane(test.thit, i), math::lane(test.normal, i)};
+        return byLane;
+    }();
     wave.forEachLane([&](int i, ShaderContext& ctx) {
         const PrimitiveHit<T>& hit = hits[size_t(i)];
         if (!hit.hit) return;

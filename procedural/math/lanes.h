@@ -52,9 +52,7 @@ struct LaneStorage<S, N, true> {
 template <class S>
 using LaneCompareInt = std::conditional_t<sizeof(S) == 8, int64_t, std::conditional_t<sizeof(S) == 4, int32_t,
                                           std::conditional_t<sizeof(S) == 2, int16_t, int8_t>>>;
-}  // namespace detail
 
-namespace detail {
 // m ? a : b over 32-bit lanes held in GCC vectors, where each lane of m has all its bits set or clear: for 8 lanes
 // one blend by m's sign bits (vblendvps), else a select on m != 0.
 template <class Mask, class V>

@@ -359,7 +359,6 @@ void RaySignedDistancePrimitiveTestQueue(const SphereTraceRay<S>* rays, int coun
     laneParams.threshold = L(params.threshold);
     laneParams.normalOffset = L(params.normalOffset);
     SphereTraceMarch<L> m;
-    LaneUint<L> i(0u);  // each lane's iteration, as the one-ray loop counts it
     marchQueue<L>(
         count, int(std::min<std::uint32_t>(params.maxSteps, std::uint32_t(1) << 30)), [](int) { return true; },
         [&](int j, int k) {
@@ -374,11 +373,10 @@ void RaySignedDistancePrimitiveTestQueue(const SphereTraceRay<S>* rays, int coun
             setLane(m.result.normal, j, from.result.normal);
             setLane(m.result.position, j, from.result.position);
             setLane(m.result.steps, j, from.result.steps);
-            setLane(i, j, from.result.steps);
         },
         [&](LaneMask<L>& running) {
-            i = select(running, i + LaneUint<L>(1u), i);
-            sphereTraceStep(ray, extent, sdf, laneParams, i, m, running);
+            // A running lane has taken `steps` iterations, each of which counted itself: this one is steps + 1.
+            sphereTraceStep(ray, extent, sdf, laneParams, m.result.steps + LaneUint<L>(1u), m, running);
         },
         [&](int j, int k) {
             SphereTraceMarch<S>& to = march[size_t(k)];

@@ -455,18 +455,16 @@ struct ProceduralWave {
     // and each lane's result at its lane.
     template <typename Hit, typename Queue>
     std::array<Hit, kMaxWaveWidth> queued(Queue&& queue) const {
-        std::array<tvec3<T>, kMaxWaveWidth> ro{}, rd{};
-        std::array<Hit, kMaxWaveWidth> results{};
-        int count = 0;
-        for (int i : marching) {
-            ro[size_t(count)] = in[size_t(i)].localRay.origin;
-            rd[size_t(count++)] = in[size_t(i)].localRay.direction;
-        }
-        queue(ro.data(), rd.data(), count, results.data());
-        std::array<Hit, kMaxWaveWidth> byLane{};
-        count = 0;
-        for (int i : marching) byLane[size_t(i)] = results[size_t(count++)];
-        return byLane;
+        return throughQueue<Hit>(
+            marching, in, [](const LaneInput<T>& l) { return l.localRay; },
+            [&](const math::Ray<T>* rays, int count, Hit* out) {
+                std::array<tvec3<T>, kMaxWaveWidth> ro{}, rd{};
+                for (int k = 0; k < count; ++k) {
+                    ro[size_t(k)] = rays[k].origin;
+                    rd[size_t(k)] = rays[k].direction;
+                }
+                queue(ro.data(), rd.data(), count, out);
+            });
     }
 };
 
@@ -501,13 +499,12 @@ void Intersection_Pacman(IntersectionWave& wave, const Accuracy& accuracy) {
     // PORT: the marching lanes' sphere tracing runs through one queue over L's lanes (a whole wave's lanes a call).
     std::array<math::SphereTraceResult<T>, kMaxWaveWidth> primitiveTest{};
     if constexpr (math::kIsLanes<L>) {
-        std::array<math::SphereTraceRay<T>, kMaxWaveWidth> rays;
-        std::array<math::SphereTraceResult<T>, kMaxWaveWidth> results;
-        int count = 0;
-        for (int i : marching) rays[size_t(count++)] = {in[size_t(i)].localRay, in[size_t(i)].extent, params.stepScale};
-        math::RaySignedDistancePrimitiveTestQueue<L>(rays.data(), count, sdf, params, results.data());
-        count = 0;
-        for (int i : marching) primitiveTest[size_t(i)] = results[size_t(count++)];
+        primitiveTest = throughQueue<math::SphereTraceResult<T>>(
+            marching, in,
+            [&params](const LaneInput<T>& l) { return math::SphereTraceRay<T>{l.localRay, l.extent, params.stepScale}; },
+            [&](const math::SphereTraceRay<T>* rays, int count, math::SphereTraceResult<T>* out) {
+                math::RaySignedDistancePrimitiveTestQueue<L>(rays, count, sdf, params, out);
+            });
     } else {
         primitiveTest[size_t(marching.lowest())] =
             math::RaySignedDistancePrimitiveTest(group.localRay, group.extent, sdf, params);  // a group of one lane
