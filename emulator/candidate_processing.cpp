@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <string_view>
 
 #include "emulator/detail/candidate_rules.h"
 #include "emulator/detail/record_lookup.h"
@@ -16,14 +17,16 @@ namespace refray::dxr::detail {
 
 namespace {
 
+[[gnu::noinline]] void emitCommit(const ThreadState& ts, const RayState& rs, const HitInfo& hit) {
+    TraceEvent e = event(ts, TraceEvent::Kind::Commit, rs.depth);
+    setHit(e, hit);
+    e.t = hit.t;
+    e.hitKind = hit.hitKind;
+    observer(ts)->onEvent(e);
+}
+
 void commit(const ThreadState& ts, RayState& rs, const HitInfo& hit) {  // TRV-4 step 4
-    if (observer(ts)) {
-        TraceEvent e = event(ts, TraceEvent::Kind::Commit, rs.depth);
-        setHit(e, hit);
-        e.t = hit.t;
-        e.hitKind = hit.hitKind;
-        observer(ts)->onEvent(e);
-    }
+    if (observer(ts)) emitCommit(ts, rs, hit);
     rs.committed = true;
     rs.committedHit = hit;
     rs.tCurrent = hit.t;
@@ -55,6 +58,39 @@ AnyHitOutcome runAnyHit(ThreadState& ts, RayState& rs, const RecordView& record,
     return outcome;
 }
 
+// The ReportHit event (out of line: an event is large, and ReportHit runs for every hit an intersection shader finds).
+[[gnu::noinline]] void emitReportHit(const ThreadState& ts, const Invocation& inv, float tHit, uint32_t hitKind,
+                                     TypeTag type) {
+    const RayState& rs = *inv.ray;
+    const ProgramEntry& group = *inv.record->entry;
+    TraceEvent e = event(ts, TraceEvent::Kind::ReportHit, rs.depth);
+    setHit(e, *inv.hit);
+    e.t = tHit;
+    e.hitKind = hitKind;
+    e.accepted = !std::isnan(tHit) && type == group.attributes && tHit >= rs.ray.TMin && tHit <= rs.tCurrent;
+    e.note = std::isnan(tHit)               ? "rejected: THit is NaN (IS-3)"
+             : !(type == group.attributes)  ? "rejected: the attributes are not the hit group's type (IS-5)"
+             : !e.accepted                  ? "ignored: THit outside [RayTMin, RayTCurrent] (IS-3)"
+             : !inv.candidateOpaque && group.anyHit ? "in range: the any-hit shader decides (IS-7)"
+                                                    : "in range: committed (IS-6)";
+    observer(ts)->onEvent(e);
+}
+
+// ReportHit's IS-3 (NaN THit), IS-4 and IS-5 reports (cold: out of the frame of every ReportHit).
+[[gnu::cold, gnu::noinline]] void raiseReportHit(ThreadState& ts, const Site& site, std::string_view rule,
+                                                 const ProgramEntry& group, float tHit, uint32_t hitKind,
+                                                 TypeTag type) {
+    if (rule == "IS-3")
+        raise(ts, site, diag("IS-3", "ReportHit called with a NaN THit; the hit is rejected").value("THit", tHit));
+    else if (rule == "IS-5")
+        raise(ts, site, diag("IS-5", "ReportHit attributes are not the type hit group '" + group.name + "' consumes")
+                            .value("reported", type.name() + " (" + std::to_string(type.size) + " B)")
+                            .value("expected", group.attributes.name() + " (" + std::to_string(group.attributes.size) + " B)"));
+    else
+        raise(ts, site, diag("IS-4", "ReportHit HitKind outside 0..127 (254 and 255 mean triangle faces)")
+                            .value("HitKind", hitKind, "0..127"));
+}
+
 }  // namespace
 
 bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attributes, TypeTag type) {
@@ -62,33 +98,17 @@ bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attrib
     RayState& rs = *inv.ray;
     const Site site = siteOf(inv);
     const ProgramEntry& group = *inv.record->entry;
-    if (observer(ts)) {
-        TraceEvent e = event(ts, TraceEvent::Kind::ReportHit, rs.depth);
-        setHit(e, *inv.hit);
-        e.t = tHit;
-        e.hitKind = hitKind;
-        e.accepted = !std::isnan(tHit) && type == group.attributes && tHit >= rs.ray.TMin && tHit <= rs.tCurrent;
-        e.note = std::isnan(tHit)               ? "rejected: THit is NaN (IS-3)"
-                 : !(type == group.attributes)  ? "rejected: the attributes are not the hit group's type (IS-5)"
-                 : !e.accepted                  ? "ignored: THit outside [RayTMin, RayTCurrent] (IS-3)"
-                 : !inv.candidateOpaque && group.anyHit ? "in range: the any-hit shader decides (IS-7)"
-                                                        : "in range: committed (IS-6)";
-        observer(ts)->onEvent(e);
-    }
+    if (observer(ts)) emitReportHit(ts, inv, tHit, hitKind, type);
     if (std::isnan(tHit)) {
-        raise(ts, site, diag("IS-3", "ReportHit called with a NaN THit; the hit is rejected").value("THit", tHit));
+        raiseReportHit(ts, site, "IS-3", group, tHit, hitKind, type);
         return false;
     }
     if (!(type == group.attributes)) {  // IS-5: checked on every call, in range or not
-        raise(ts, site, diag("IS-5", "ReportHit attributes are not the type hit group '" + group.name + "' consumes")
-                            .value("reported", type.name() + " (" + std::to_string(type.size) + " B)")
-                            .value("expected", group.attributes.name() + " (" + std::to_string(group.attributes.size) + " B)"));
+        raiseReportHit(ts, site, "IS-5", group, tHit, hitKind, type);
         return false;
     }
     if (tHit < rs.ray.TMin || tHit > rs.tCurrent) return false;  // IS-3: closed interval
-    if (hitKind > kMaxProceduralHitKind)
-        raise(ts, site, diag("IS-4", "ReportHit HitKind outside 0..127 (254 and 255 mean triangle faces)")
-                            .value("HitKind", hitKind, "0..127"));
+    if (hitKind > kMaxProceduralHitKind) raiseReportHit(ts, site, "IS-4", group, tHit, hitKind, type);
     HitInfo candidate = *inv.hit;
     candidate.t = tHit;
     candidate.hitKind = hitKind;

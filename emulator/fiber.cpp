@@ -45,10 +45,18 @@ refray_fiber_switch:
     subq $16, %rsp
     stmxcsr 8(%rsp)
     fnstcw (%rsp)
+    movl 8(%rsp), %eax
+    movzwl (%rsp), %ecx
     movq %rsp, (%rdi)
     movq %rsi, %rsp
-    fldcw (%rsp)
+    cmpl 8(%rsp), %eax
+    je 1f
     ldmxcsr 8(%rsp)
+1:
+    cmpw (%rsp), %cx
+    je 2f
+    fldcw (%rsp)
+2:
     addq $16, %rsp
     popq %r15
     popq %r14

@@ -22,38 +22,59 @@ void countInvocation(ThreadState& ts, const ShaderExport* shader) {
 
 }  // namespace
 
+namespace {
+
+// The PIPE-6 and PAY-1 reports (cold: out of the frames of the shader calls that check).
+[[gnu::cold, gnu::noinline]] void raiseGlobalSignature(ThreadState& ts, const Site& site, const ProgramEntry& entry,
+                                                       const RootSignature* bound) {
+    raise(ts, site,
+          diag("PIPE-6", "'" + entry.name + "' uses a global root signature other than the one bound for the dispatch")
+              .value("shader's", entry.globalRootSignature->name())
+              .value("bound", bound ? bound->name() : std::string("(none)")));
+}
+
+[[gnu::cold, gnu::noinline]] void raisePayload(ThreadState& ts, const Site& site, const ShaderExport& shader,
+                                               TypeTag traced) {
+    raise(ts, site, diag("PAY-1", std::string(toString(shader.stage)) + " shader '" + shader.name +
+                                      "' declares another payload type than the TraceRay that invokes it")
+                        .value("TraceRay payload", traced.name() + " (" + std::to_string(traced.size) + " B)")
+                        .value("shader payload", shader.payload.name() + " (" + std::to_string(shader.payload.size) + " B)"));
+}
+
+}  // namespace
+
 void checkGlobalSignature(ThreadState& ts, const Site& site, const ProgramEntry& entry) {
     const DispatchState& ds = *ts.dispatch;
     const RootSignature* bound = ds.global ? ds.global->signature().get() : nullptr;
     if (entry.globalRootSignature && entry.globalRootSignature.get() != bound)
-        raise(ts, site,
-              diag("PIPE-6", "'" + entry.name + "' uses a global root signature other than the one bound for the dispatch")
-                  .value("shader's", entry.globalRootSignature->name())
-                  .value("bound", bound ? bound->name() : std::string("(none)")));
+        raiseGlobalSignature(ts, site, entry, bound);
 }
 
 void checkPayload(ThreadState& ts, const Site& site, const ShaderExport& shader, TypeTag traced) {
-    if (!(shader.payload == traced))
-        raise(ts, site, diag("PAY-1", std::string(toString(shader.stage)) + " shader '" + shader.name +
-                                          "' declares another payload type than the TraceRay that invokes it")
-                            .value("TraceRay payload", traced.name() + " (" + std::to_string(traced.size) + " B)")
-                            .value("shader payload", shader.payload.name() + " (" + std::to_string(shader.payload.size) + " B)"));
+    if (!(shader.payload == traced)) raisePayload(ts, site, shader, traced);
 }
+
+namespace {
+
+// The ShaderCall event (out of line: an event is large, and beginInvocation runs for every shader call).
+[[gnu::noinline]] void emitShaderCall(const ThreadState& ts, const Invocation& inv) {
+    TraceEvent e = event(ts, TraceEvent::Kind::ShaderCall, inv.depth);
+    e.stage = inv.stage;
+    e.exportName = inv.shader->name;
+    if (inv.record) {
+        e.recordIndex = inv.record->index;
+        e.recordAddress = inv.record->address;
+    }
+    if (inv.hit) setHit(e, *inv.hit);
+    observer(ts)->onEvent(e);
+}
+
+}  // namespace
 
 uint8_t beginInvocation(ThreadState& ts, const Invocation& inv) {
     ts.stats.invocations[size_t(inv.stage)]++;
     countInvocation(ts, inv.shader);
-    if (observer(ts)) {
-        TraceEvent e = event(ts, TraceEvent::Kind::ShaderCall, inv.depth);
-        e.stage = inv.stage;
-        e.exportName = inv.shader->name;
-        if (inv.record) {
-            e.recordIndex = inv.record->index;
-            e.recordAddress = inv.record->address;
-        }
-        if (inv.hit) setHit(e, *inv.hit);
-        observer(ts)->onEvent(e);
-    }
+    if (observer(ts)) emitShaderCall(ts, inv);
     ts.callChain.push_back(inv.shader);
     return ts.profiling ? ts.clock.enter(uint8_t(profileStageOf(inv.stage))) : StageClock::kOutside;
 }

@@ -61,11 +61,12 @@ std::string vec3Values(const vec3& v) {
 
 }  // namespace
 
-void validateRay(ThreadState& ts, const Site& site, const RayDesc& ray, bool& ok, const char* rule) {
-    // inTraversalRange also fails for NaN and infinite components, so it covers their finiteness too.
-    if (inTraversalRange(ray) && std::isfinite(ray.TMin) && !std::isnan(ray.TMax) && ray.TMin >= 0.0f &&
-        ray.TMin <= ray.TMax && ray.Direction != vec3(0.0f))
-        return;  // the common case: nothing to report
+namespace {
+
+// validateRay's reports, for a ray that is not plainly valid: out of line, so that the common case's frame (and the
+// frames of TraceRay and RayQuery around it) stays small.
+[[gnu::cold, gnu::noinline]] void reportRay(ThreadState& ts, const Site& site, const RayDesc& ray, bool& ok,
+                                            const char* rule) {
     auto field = [&](const char* name, float v) {
         if (std::isnan(v)) {
             raise(ts, site, diag(rule, std::string("RayDesc.") + name + " is NaN").value(name, v));
@@ -103,20 +104,41 @@ void validateRay(ThreadState& ts, const Site& site, const RayDesc& ray, bool& ok
                            .value("Direction", vec3Values(ray.Direction)));
 }
 
+}  // namespace
+
+void validateRay(ThreadState& ts, const Site& site, const RayDesc& ray, bool& ok, const char* rule) {
+    // inTraversalRange also fails for NaN and infinite components, so it covers their finiteness too.
+    if (inTraversalRange(ray) && std::isfinite(ray.TMin) && !std::isnan(ray.TMax) && ray.TMin >= 0.0f &&
+        ray.TMin <= ray.TMax && ray.Direction != vec3(0.0f))
+        return;  // the common case: nothing to report
+    reportRay(ts, site, ray, ok, rule);
+}
+
+namespace {
+
+// validateFlags' report of a broken flag rule (cold: out of the callers' frames).
+[[gnu::cold, gnu::noinline]] bool reportFlags(ThreadState& ts, const Site& site, uint32_t rayFlags,
+                                              uint32_t pipelineFlags, const char* queryRule, const char* rule,
+                                              const char* what) {
+    if (queryRule)
+        raise(ts, site, diag(queryRule, what)
+                            .value("template flags", rayFlagsToString(pipelineFlags))
+                            .value("TraceRayInline flags", rayFlagsToString(rayFlags))
+                            .value("OR'd", rayFlagsToString(rayFlags | pipelineFlags)));
+    else
+        raise(ts, site, diag(rule, what)
+                            .value("TraceRay flags", rayFlagsToString(rayFlags))
+                            .value("pipeline flags", pipelineFlagsToString(pipelineFlags)));
+    return false;
+}
+
+}  // namespace
+
 bool validateFlags(ThreadState& ts, const Site& site, uint32_t rayFlags, uint32_t pipelineFlags,
                    const char* queryRule) {
     const uint32_t eff = rayFlags | pipelineFlags;
-    auto fail = [&](const char* rule, const std::string& what) {
-        if (queryRule)
-            raise(ts, site, diag(queryRule, what)
-                                .value("template flags", rayFlagsToString(pipelineFlags))
-                                .value("TraceRayInline flags", rayFlagsToString(rayFlags))
-                                .value("OR'd", rayFlagsToString(eff)));
-        else
-            raise(ts, site, diag(rule, what)
-                                .value("TraceRay flags", rayFlagsToString(rayFlags))
-                                .value("pipeline flags", pipelineFlagsToString(pipelineFlags)));
-        return false;
+    auto fail = [&](const char* rule, const char* what) {
+        return reportFlags(ts, site, rayFlags, pipelineFlags, queryRule, rule, what);
     };
     const uint32_t opacity = eff & (RAY_FLAG_FORCE_OPAQUE | RAY_FLAG_FORCE_NON_OPAQUE | RAY_FLAG_CULL_OPAQUE | RAY_FLAG_CULL_NON_OPAQUE);
     if (opacity & (opacity - 1))
@@ -133,8 +155,9 @@ bool validateFlags(ThreadState& ts, const Site& site, uint32_t rayFlags, uint32_
 
 namespace {
 
-// The TraceRay and TraceRayEnd events. `asAddress` and `mask` are the TraceRay arguments as passed.
-void emitRay(const ThreadState& ts, const RayState& rs, TraceEvent::Kind kind, GpuVirtualAddress asAddress,
+// The TraceRay and TraceRayEnd events. `asAddress` and `mask` are the TraceRay arguments as passed. Out of line: the
+// event is large, and TraceRay's frame stays with the lane while its closest-hit shader runs.
+[[gnu::noinline]] void emitRay(const ThreadState& ts, const RayState& rs, TraceEvent::Kind kind, GpuVirtualAddress asAddress,
              uint32_t mask) {
     TraceEvent e = event(ts, kind, rs.depth);
     e.accelerationStructure = asAddress;
@@ -225,6 +248,30 @@ void runClosestHitOrMiss(ThreadState& ts, RayState& rs, const Site& site) {
 
 }  // namespace
 
+namespace {
+
+// TraceRay's argument reports (cold: out of its frame, which stays with the lane while its closest-hit shader runs).
+[[gnu::cold, gnu::noinline]] void raiseRecursionLimit(ThreadState& ts, const Site& site, uint32_t depth) {
+    const uint32_t limit = ts.dispatch->pipeline->maxTraceRecursionDepth();
+    raise(ts, site, diag("LIM-2", "TraceRay at the recursion limit: a call at depth == MaxTraceRecursionDepth removes the device")
+                        .value("depth", depth, "< MaxTraceRecursionDepth " + std::to_string(limit))
+                        .value("call chain", describeCallChain(ts)));
+}
+
+[[gnu::cold, gnu::noinline]] void raiseUndefinedFlags(ThreadState& ts, const Site& site, uint32_t rayFlags) {
+    raise(ts, site, diag("RAY-10", "TraceRay flags set undefined bits")
+                        .hex("RayFlags", rayFlags)
+                        .hex("undefined bits", rayFlags & ~kDefinedRayFlags));
+}
+
+[[gnu::cold, gnu::noinline]] void warnIndexBits(ThreadState& ts, const Site& site, uint32_t r, uint32_t m) {
+    warn(ts, site, warning("IDX-2", "TraceRay index arguments have bits above the low 4; DXR ignores them")
+                       .value("RayContributionToHitGroupIndex", r, "0..15")
+                       .value("MultiplierForGeometryContributionToHitGroupIndex", m, "0..15"));
+}
+
+}  // namespace
+
 const TopLevelAS* findTopLevelAS(ThreadState& ts, const Site& site, GpuVirtualAddress asAddress) {
     const TopLevelAS* tlas = lookupTopLevelAS(ts, asAddress);
     if (!tlas) {
@@ -243,25 +290,18 @@ void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags
 
     // The arguments: LIM-2, RAY-10 (undefined bits are dropped), FLAG-2..5, RAY-5 and RAY-7, IDX-2.
     if (caller.depth >= ds.pipeline->maxTraceRecursionDepth()) {  // LIM-2
-        raise(ts, site, diag("LIM-2", "TraceRay at the recursion limit: a call at depth == MaxTraceRecursionDepth removes the device")
-                            .value("depth", caller.depth, "< MaxTraceRecursionDepth " + std::to_string(ds.pipeline->maxTraceRecursionDepth()))
-                            .value("call chain", describeCallChain(ts)));
+        raiseRecursionLimit(ts, site, caller.depth);
         return;  // fallback: the call does nothing
     }
     if (rayFlags & ~kDefinedRayFlags) {  // RAY-10
-        raise(ts, site, diag("RAY-10", "TraceRay flags set undefined bits")
-                            .hex("RayFlags", rayFlags)
-                            .hex("undefined bits", rayFlags & ~kDefinedRayFlags));
+        raiseUndefinedFlags(ts, site, rayFlags);
         rayFlags &= kDefinedRayFlags;
     }
     if (!validateFlags(ts, site, rayFlags, ds.pipeline->pipelineFlags())) return;
     bool rayOk = true;
     validateRay(ts, site, ray, rayOk, "RAY-5");
     if (!rayOk) return;
-    if ((r & ~kRayContributionMask) || (m & ~kGeometryMultiplierMask))  // IDX-2
-        warn(ts, site, warning("IDX-2", "TraceRay index arguments have bits above the low 4; DXR ignores them")
-                           .value("RayContributionToHitGroupIndex", r, "0..15")
-                           .value("MultiplierForGeometryContributionToHitGroupIndex", m, "0..15"));
+    if ((r & ~kRayContributionMask) || (m & ~kGeometryMultiplierMask)) warnIndexBits(ts, site, r, m);  // IDX-2
 
     RayState rs;
     rs.ray = ray;
