@@ -3,6 +3,7 @@
 #include <array>
 #include <chrono>
 #include <functional>
+#include <optional>
 #include <span>
 
 #include <tbb/blocked_range2d.h>
@@ -19,6 +20,7 @@
 #include "emulator/detail/wave.h"
 #include "emulator/device.h"
 #include "emulator/limits.h"
+#include "emulator/ray_generation_wave.h"
 
 namespace refray::dxr {
 
@@ -141,13 +143,31 @@ void recordStopError(ThreadState& ts, DispatchState& ds, Diagnostic d) {
     }
 }
 
-// One launch: the ray generation shader at `launch`, unless an earlier launch has stopped the dispatch.
-void runLaunch(ThreadState& ts, DispatchState& ds, uvec3 launch) {
+// A launch's start: its index, and false when an earlier launch has stopped the dispatch (the launch is skipped).
+bool startLaunch(ThreadState& ts, DispatchState& ds, uvec3 launch) {
     ts.launchIndex = launch;
     ts.linearIndex = linearIndex(*ds.desc, launch);
-    if (ts.linearIndex > ds.firstErrorIndex.load(std::memory_order_relaxed)) return;
+    if (ts.linearIndex > ds.firstErrorIndex.load(std::memory_order_relaxed)) return false;
     ts.rayCounter = 0;
     ts.queriesTraced = 0;
+    return true;
+}
+
+// What ended the launch of `inv` early: kept when it is a DXR error (or another refray error, under GEN-1);
+// anything else is rethrown.
+void recordLaunchFailure(ThreadState& ts, DispatchState& ds, const detail::Invocation& inv, std::exception_ptr failure) {
+    try {
+        std::rethrow_exception(std::move(failure));
+    } catch (const DxrError& e) {
+        recordStopError(ts, ds, e.diagnostic());
+    } catch (const Error& e) {
+        recordStopError(ts, ds, detail::locate(ts, diag("GEN-1", e.what()), detail::siteOf(inv)));
+    }
+}
+
+// One launch: the ray generation shader at `launch`, unless an earlier launch has stopped the dispatch.
+void runLaunch(ThreadState& ts, DispatchState& ds, uvec3 launch) {
+    if (!startLaunch(ts, ds, launch)) return;
     detail::Invocation inv =
         ds.computeShader
             ? detail::invocation(ts, ShaderStage::Compute, ds.computeShader, nullptr, 0)
@@ -155,11 +175,62 @@ void runLaunch(ThreadState& ts, DispatchState& ds, uvec3 launch) {
     try {
         if (!ds.computeShader) detail::checkGlobalSignature(ts, detail::siteOf(inv), *ds.rayGenRecord.entry);
         detail::invoke(ts, inv, nullptr, nullptr);
-    } catch (const DxrError& e) {
-        recordStopError(ts, ds, e.diagnostic());
-    } catch (const Error& e) {
-        recordStopError(ts, ds, detail::locate(ts, diag("GEN-1", e.what()), detail::siteOf(inv)));
+    } catch (const DxrError&) {
+        recordLaunchFailure(ts, ds, inv, std::current_exception());
+    } catch (const Error&) {
+        recordLaunchFailure(ts, ds, inv, std::current_exception());
     }
+}
+
+// The launches of a wave whose ray generation shader is written for waves (emulator/ray_generation_wave.h): each
+// lane starts as runLaunch starts it, the shader runs once over the lanes on the worker's own stack, and each lane's
+// failure is recorded as runLaunch records it.
+void runLaunchWave(Wave& wave, DispatchState& ds, std::span<const uvec3> launches) {
+    detail::openWave(wave, launches.size());
+    const ShaderExport& shader = *ds.rayGenRecord.entry->shader;
+    std::array<std::optional<detail::Invocation>, kMaxWaveWidth> invocations;
+    std::array<std::optional<ShaderContext>, kMaxWaveWidth> contexts;
+    std::array<ShaderContext*, kMaxWaveWidth> lanes{};
+    std::array<uint8_t, kMaxWaveWidth> callerSections{};
+    LaneMask active;
+    for (size_t i = 0; i < launches.size(); ++i) {
+        ThreadState& ts = wave.lanes[i].ts;
+        wave.lanes[i].launch = launches[i];
+        if (!startLaunch(ts, ds, launches[i])) continue;
+        const detail::Invocation& inv = invocations[i].emplace(
+            detail::invocation(ts, ShaderStage::RayGeneration, &shader, &ds.rayGenRecord, 0));
+        try {
+            detail::checkGlobalSignature(ts, detail::siteOf(inv), *ds.rayGenRecord.entry);
+        } catch (...) {
+            recordLaunchFailure(ts, ds, inv, std::current_exception());
+            continue;
+        }
+        callerSections[i] = detail::beginInvocation(ts, inv);
+        lanes[i] = &contexts[i].emplace(*invocations[i]);
+        active.set(int(i));
+    }
+    if (active.empty()) return;
+    RayGenerationWave shaderWave(lanes, active, &wave);
+    std::exception_ptr escaped;
+    try {
+        shader.waveRayGeneration(shaderWave);
+    } catch (...) {
+        escaped = std::current_exception();  // not one lane's: it stops every lane still running the shader
+    }
+    std::exception_ptr unexpected;
+    for (int i : active) {
+        ThreadState& ts = wave.lanes[size_t(i)].ts;
+        detail::endInvocation(ts, callerSections[size_t(i)]);
+        std::exception_ptr failure = shaderWave.failure(i);
+        if (!failure && escaped && shaderWave.isActive(i)) failure = escaped;
+        if (!failure) continue;
+        try {
+            recordLaunchFailure(ts, ds, *invocations[size_t(i)], failure);
+        } catch (...) {
+            if (!unexpected) unexpected = std::current_exception();  // not an error of refray's: the dispatch's
+        }
+    }
+    if (unexpected) std::rethrow_exception(unexpected);
 }
 
 // The lanes per wave the dispatch runs: DispatchOptions::waveWidth, or one for an observed or profiled dispatch.
@@ -187,6 +258,9 @@ void runTiles(DispatchState& ds, const LaunchRegion& region, Waves& waves) {
     const int width = waveWidth(options);
     const uvec2 block = waveBlock(width);
     const detail::LaunchFunction launch = [&ds](ThreadState& ts, uvec3 at) { runLaunch(ts, ds, at); };
+    // A ray generation shader written for waves runs once a wave; one lane at a time it runs alone, on its fiber.
+    const bool waveRayGeneration =
+        width > 1 && !ds.computeShader && ds.rayGenRecord.entry && ds.rayGenRecord.entry->shader->waveRayGeneration;
     const int arenaThreads = options.threads ? int(options.threads) : tbb::task_arena::automatic;
     tbb::task_arena arena(arenaThreads);
     arena.execute([&] {
@@ -202,7 +276,9 @@ void runTiles(DispatchState& ds, const LaunchRegion& region, Waves& waves) {
                             for (uint32_t y = y0; y < std::min(y0 + block.y, range.rows().end()); ++y)
                                 for (uint32_t x = x0; x < std::min(x0 + block.x, range.cols().end()); ++x)
                                     launches[count++] = uvec3(x, y, z);
-                            detail::runWave(wave, std::span<const uvec3>(launches.data(), count), launch);
+                            const std::span<const uvec3> lanes(launches.data(), count);
+                            if (waveRayGeneration) runLaunchWave(wave, ds, lanes);
+                            else detail::runWave(wave, lanes, launch);
                         }
                 if (options.progress) options.progress->advance(range.rows().size() * range.cols().size());
             });

@@ -101,9 +101,15 @@ void saveLocals(void** into) {
     const FiberLocal* locals = fiberLocals();
     for (size_t i = 0, n = fiberLocalCount(); i < n; ++i) into[i] = locals[i].get();
 }
-void loadLocals(void* const* from) {
+// Saves the values now in place into `saveInto` and puts those of `loadFrom` in their place; a value that is already
+// in place (a float render's perturbation context: none on every fiber) is not set again.
+void swapLocals(void** saveInto, void* const* loadFrom) {
     const FiberLocal* locals = fiberLocals();
-    for (size_t i = 0, n = fiberLocalCount(); i < n; ++i) locals[i].set(from[i]);
+    for (size_t i = 0, n = fiberLocalCount(); i < n; ++i) {
+        void* const now = locals[i].get();
+        if (now != loadFrom[i]) locals[i].set(loadFrom[i]);
+        saveInto[i] = now;
+    }
 }
 
 }  // namespace
@@ -176,8 +182,7 @@ void Fiber::resume() {
     REFRAY_CHECK(running_, "a fiber was resumed with no body to run");
     previous_ = tCurrentFiber;
     tCurrentFiber = this;
-    saveLocals(callerLocals_);
-    loadLocals(locals_);
+    swapLocals(callerLocals_, locals_);
 #if REFRAY_FIBER_ASAN
     void* callerFakeStack = nullptr;
     const size_t page = pageSize();
@@ -187,8 +192,7 @@ void Fiber::resume() {
 #if REFRAY_FIBER_ASAN
     __sanitizer_finish_switch_fiber(callerFakeStack, nullptr, nullptr);
 #endif
-    saveLocals(locals_);
-    loadLocals(callerLocals_);
+    swapLocals(locals_, callerLocals_);
     tCurrentFiber = previous_;
     if (!running_ && failure_) {
         std::exception_ptr failure = std::move(failure_);

@@ -118,7 +118,7 @@ void ShaderContext::traceRay(GpuVirtualAddress as, uint32_t flags, uint32_t mask
     // Timed here rather than inside detail::traceRay: a cleanup there would lengthen the unwind table that
     // every end-search signal caught in it walks. The shaders it invokes charge their own time.
     const detail::ProfileScope traversal(*inv_.thread, ProfileStage::Traversal);
-    detail::traceRay(inv_, as, flags, mask, r, m, miss, ray, payload, payloadType);
+    detail::traceRay(inv_, TraceRayCall{as, flags, mask, r, m, miss, ray, payload, payloadType});
 }
 
 void ShaderContext::callShader(uint32_t index, void* parameters, TypeTag type) {

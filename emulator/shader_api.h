@@ -17,6 +17,7 @@
 #include "emulator/descriptor_heap.h"
 #include "emulator/detail/invocation.h"
 #include "emulator/ray_query.h"
+#include "emulator/trace_ray_call.h"
 #include "emulator/wave_call.h"
 
 namespace refray::dxr {
@@ -30,6 +31,7 @@ struct ArgumentBytes;  // dispatch_state.h
 class ShaderContext;
 class RayQueryObject;
 class IntersectionWave;
+class RayGenerationWave;
 
 // HLSL SamplerState: a sampler resolved from an s register by ShaderContext::SamplerState. Valid for the dispatch
 // that resolved it.
@@ -130,6 +132,12 @@ public:
         traceRay(accelerationStructure, RayFlags, InstanceInclusionMask, RayContributionToHitGroupIndex,
                  MultiplierForGeometryContributionToHitGroupIndex, MissShaderIndex, Ray, &payload,
                  typeTag<Payload>());
+    }
+
+    // The same TraceRay, its arguments held in a TraceRayCall (emulator/trace_ray_call.h).
+    void TraceRay(const TraceRayCall& call) {
+        traceRay(call.accelerationStructure, call.rayFlags, call.instanceInclusionMask, call.rayContribution,
+                 call.multiplier, call.missShaderIndex, call.ray, call.payload, call.payloadType);
     }
 
     // --- CallShader (CALL-1): ray generation, closest-hit, miss and callable shaders.
@@ -238,6 +246,7 @@ public:
 private:
     friend class RayQueryObject;  // a query belongs to the invocation that made it (emulator/ray_query.h)
     friend class IntersectionWave;  // reads whether a lane's ReportHit ended its search (emulator/intersection_wave.h)
+    friend class RayGenerationWave;  // issues its lanes' TraceRays together (emulator/ray_generation_wave.h)
 
     // Stage masks for SV-1.
     static constexpr uint8_t bit(ShaderStage s) { return detail::stageBit(s); }

@@ -9,6 +9,7 @@
 
 #include "core/strings.h"
 #include "emulator/intersection_wave.h"
+#include "emulator/ray_generation_wave.h"
 #include "emulator/limits.h"
 #include "emulator/validation.h"
 
@@ -36,6 +37,14 @@ std::string_view toString(ProgramEntry::Kind kind) {
 void ShaderLibrary::addRayGeneration(std::string name, std::function<void(ShaderContext&)> fn) {
     add({std::move(name), ShaderStage::RayGeneration, {}, {}, {},
          [fn = std::move(fn)](ShaderContext& c, void*, const void*) { fn(c); }});
+}
+
+void ShaderLibrary::addWaveRayGeneration(std::string name, WaveRayGenerationShader fn) {
+    REFRAY_CHECK(fn, "shader export '" << name << "' has no function");
+    ShaderExport e{std::move(name), ShaderStage::RayGeneration, {}, {}, {},
+                   [fn](ShaderContext& c, void*, const void*) { RayGenerationWave::runAlone(fn, c); }};
+    e.waveRayGeneration = std::move(fn);
+    add(std::move(e));
 }
 
 void ShaderLibrary::addCompute(std::string name, uvec3 numThreads, std::function<void(ShaderContext&)> fn) {

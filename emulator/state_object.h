@@ -43,7 +43,9 @@ using ErasedShader = std::function<void(ShaderContext&, void* payload, const voi
 
 // An intersection shader written for waves (emulator/intersection_wave.h): run once over the lanes of a record group.
 class IntersectionWave;
+class RayGenerationWave;
 using WaveIntersectionShader = std::function<void(IntersectionWave&)>;
+using WaveRayGenerationShader = std::function<void(RayGenerationWave&)>;
 
 // How an intersection shader ends when one of its ReportHit calls ends the search (IS-10: FLAG-8, or an any-hit
 // shader's AcceptHitAndEndSearch). docs/emulator.md, "Ending an intersection shader".
@@ -75,6 +77,8 @@ struct ShaderExport {
     // The most lanes one waveIntersection call takes (the width of its SIMD math): a larger record group runs in
     // parts of at most this many lanes, each part's lanes numbered from 0.
     int waveLanesPerCall = kMaxWaveWidth;
+    // Ray generation written for waves: a wave of launches calls this once; `function` runs it for one lane alone.
+    WaveRayGenerationShader waveRayGeneration = {};
 };
 
 // A DXIL library: named shader exports. Signatures mirror HLSL entry points:
@@ -83,6 +87,9 @@ struct ShaderExport {
 class ShaderLibrary {
 public:
     void addRayGeneration(std::string name, std::function<void(ShaderContext&)> fn);
+    // A ray generation shader written for waves (emulator/ray_generation_wave.h): one call runs a wave's launches,
+    // whose TraceRays it issues together through RayGenerationWave::TraceRay.
+    void addWaveRayGeneration(std::string name, WaveRayGenerationShader fn);
     // [numthreads(x, y, z)] [shader("compute")] void CS(uint3 id : SV_DispatchThreadID): run by Device::dispatch, not
     // part of the ray-tracing pipeline (no identifier); it reads its thread ids from ShaderContext.
     void addCompute(std::string name, uvec3 numThreads, std::function<void(ShaderContext&)> fn);

@@ -3,6 +3,7 @@
 #include "emulator/detail/trace_ray.h"
 
 #include <cmath>
+#include <optional>
 
 #include "emulator/detail/record_lookup.h"
 #include "emulator/detail/shader_invocation.h"
@@ -282,58 +283,74 @@ const TopLevelAS* findTopLevelAS(ThreadState& ts, const Site& site, GpuVirtualAd
     return tlas;
 }
 
-void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags, uint32_t mask, uint32_t r,
-              uint32_t m, uint32_t missIndex, const RayDesc& ray, void* payload, TypeTag payloadType) {
+TraceRayStart beginTraceRay(Invocation& caller, const TraceRayCall& call, RayState& rs,
+                            std::optional<ValueCopy>& payload) {
     ThreadState& ts = *caller.thread;
     const DispatchState& ds = *ts.dispatch;
     const Site site = siteOf(caller);
+    uint32_t rayFlags = call.rayFlags;
+    const uint32_t r = call.rayContribution, m = call.multiplier;
 
     // The arguments: LIM-2, RAY-10 (undefined bits are dropped), FLAG-2..5, RAY-5 and RAY-7, IDX-2.
     if (caller.depth >= ds.pipeline->maxTraceRecursionDepth()) {  // LIM-2
         raiseRecursionLimit(ts, site, caller.depth);
-        return;  // fallback: the call does nothing
+        return TraceRayStart::Ended;  // fallback: the call does nothing
     }
     if (rayFlags & ~kDefinedRayFlags) {  // RAY-10
         raiseUndefinedFlags(ts, site, rayFlags);
         rayFlags &= kDefinedRayFlags;
     }
-    if (!validateFlags(ts, site, rayFlags, ds.pipeline->pipelineFlags())) return;
+    if (!validateFlags(ts, site, rayFlags, ds.pipeline->pipelineFlags())) return TraceRayStart::Ended;
     bool rayOk = true;
-    validateRay(ts, site, ray, rayOk, "RAY-5");
-    if (!rayOk) return;
+    validateRay(ts, site, call.ray, rayOk, "RAY-5");
+    if (!rayOk) return TraceRayStart::Ended;
     if ((r & ~kRayContributionMask) || (m & ~kGeometryMultiplierMask)) warnIndexBits(ts, site, r, m);  // IDX-2
 
-    RayState rs;
-    rs.ray = ray;
+    rs.ray = call.ray;
     rs.rayFlags = rayFlags;
     rs.effectiveFlags = rayFlags | ds.pipeline->pipelineFlags();
-    rs.instanceInclusionMask = mask & kInstanceInclusionMaskBits;
+    rs.instanceInclusionMask = call.instanceInclusionMask & kInstanceInclusionMaskBits;
     rs.rayContribution = r;
     rs.multiplier = m;
-    rs.missShaderIndex = missIndex;
+    rs.missShaderIndex = call.missShaderIndex;
     rs.depth = caller.depth + 1;
-    rs.tCurrent = ray.TMax;
-    rs.payloadType = payloadType;
+    rs.tCurrent = call.ray.TMax;
+    rs.payloadType = call.payloadType;
 
     // RAY-9: the payload is passed by value.
-    ValueCopy local(payload, payloadType.size);
-    rs.payload = local.data();
-    if (observer(ts)) emitRay(ts, rs, TraceEvent::Kind::TraceRay, asAddress, mask);
+    rs.payload = payload.emplace(call.payload, call.payloadType.size).data();
+    if (observer(ts)) emitRay(ts, rs, TraceEvent::Kind::TraceRay, call.accelerationStructure, call.instanceInclusionMask);
 
-    countRay(ts, {r & kRayContributionMask, missIndex & kMissShaderIndexMask}, rs.depth);
+    countRay(ts, {r & kRayContributionMask, call.missShaderIndex & kMissShaderIndexMask}, rs.depth);
     ts.rayCounter++;
 
     // RAY-7: an infinite origin or direction component makes the plain math NaN, so the ray finds nothing;
     // components beyond Embree's range get the same treatment. Embree never sees either kind of ray.
-    const bool traceable = inTraversalRange(ray);  // false for NaN and infinite components too
-    if (asAddress != 0 && traceable) {
-        rs.tlas = findTopLevelAS(ts, site, asAddress);
-        if (!rs.tlas) return;
-        awaitTraversal(ts, rs, site);  // the wave's packet gathers and processes the candidates (detail/wave.h)
+    const bool traceable = inTraversalRange(call.ray);  // false for NaN and infinite components too
+    if (call.accelerationStructure == 0 || !traceable) return TraceRayStart::Invoke;
+    rs.tlas = findTopLevelAS(ts, site, call.accelerationStructure);
+    return rs.tlas ? TraceRayStart::Traverse : TraceRayStart::Ended;
+}
+
+void finishTraceRay(Invocation& caller, const TraceRayCall& call, RayState& rs, ValueCopy& payload) {
+    ThreadState& ts = *caller.thread;
+    runClosestHitOrMiss(ts, rs, siteOf(caller));
+    if (observer(ts)) emitRay(ts, rs, TraceEvent::Kind::TraceRayEnd, call.accelerationStructure, call.instanceInclusionMask);
+    payload.copyBack(call.payload);
+}
+
+void traceRay(Invocation& caller, const TraceRayCall& call) {
+    RayState rs;
+    std::optional<ValueCopy> payload;
+    switch (beginTraceRay(caller, call, rs, payload)) {
+        case TraceRayStart::Ended: return;
+        case TraceRayStart::Traverse:
+            // The wave's packet gathers and processes the candidates (detail/wave.h).
+            awaitTraversal(*caller.thread, rs, siteOf(caller));
+            break;
+        case TraceRayStart::Invoke: break;
     }
-    runClosestHitOrMiss(ts, rs, site);
-    if (observer(ts)) emitRay(ts, rs, TraceEvent::Kind::TraceRayEnd, asAddress, mask);
-    local.copyBack(payload);
+    finishTraceRay(caller, call, rs, *payload);
 }
 
 }  // namespace refray::dxr::detail

@@ -2,7 +2,12 @@
 // traversal or their call.
 #include "emulator/detail/wave.h"
 
+#include <xmmintrin.h>
+
+#include <optional>
+
 #include "core/error.h"
+#include "emulator/detail/trace_ray.h"
 
 namespace refray::dxr::detail {
 
@@ -32,27 +37,20 @@ void resumeLanes(Wave& wave, LaneMask lanes) {
     }
 }
 
-}  // namespace
 
-void runWave(Wave& wave, std::span<const uvec3> launches, const LaunchFunction& launch) {
-    REFRAY_ASSERT(launches.size() <= size_t(kMaxWaveWidth), "a wave of " << launches.size() << " lanes");
-    wave.parked = LaneMask();
-    wave.calling = LaneMask();
-    wave.grouped = launches.size() > 1;
-    for (size_t i = 0; i < launches.size(); ++i) {
-        WaveLane& lane = wave.lanes[i];
-        lane.failure = nullptr;
-        // Lane i's frames start 11*i lines (mod a page) below its stack's top: the lanes' hottest frames spread over
-        // the L1 cache's sets instead of sharing them (the stacks' mappings lie whole pages apart).
-        if (!wave.fibers[i])
-            wave.fibers[i] = std::make_unique<Fiber>(Fiber::defaultStackBytes(), unsigned(i) * 11u % Fiber::kColours);
-        lane.launch = launches[i];
-        wave.fibers[i]->start([&launch, &lane] { launch(lane.ts, lane.launch); });  // two pointers: no allocation
-    }
-    // Each lane runs until its first TraceRay, wave call or its end; then the waiting calls run grouped and their
-    // lanes go on, or, when no lane waits on a call, the parked rays traverse together and their lanes go on, until
-    // none is left.
-    resumeLanes(wave, LaneMask::first(int(launches.size())));
+// Lane i's fiber, made on first use. Lane i's frames start 11*i lines (mod a page) below its stack's top: the lanes'
+// hottest frames spread over the L1 cache's sets instead of sharing them (the stacks' mappings lie whole pages apart).
+Fiber& laneFiber(Wave& wave, int i) {
+    std::unique_ptr<Fiber>& fiber = wave.fibers[size_t(i)];
+    if (!fiber) fiber = std::make_unique<Fiber>(Fiber::defaultStackBytes(), unsigned(i) * 11u % Fiber::kColours);
+    return *fiber;
+}
+
+// Runs the started fibers of `lanes` until every one has ended: each runs until its next TraceRay, wave call or its
+// end; then the waiting calls run grouped and their lanes go on, or, when no lane waits on a call, the parked rays
+// traverse together and their lanes go on, until none is left.
+void runLanes(Wave& wave, LaneMask lanes) {
+    resumeLanes(wave, lanes);
     while (wave.parked.any() || wave.calling.any()) {
         if (wave.calling.any()) {
             const LaneMask calls = wave.calling;
@@ -68,7 +66,135 @@ void runWave(Wave& wave, std::span<const uvec3> launches, const LaunchFunction& 
     }
 }
 
+}  // namespace
+
+void openWave(Wave& wave, size_t lanes) {
+    REFRAY_ASSERT(lanes <= size_t(kMaxWaveWidth), "a wave of " << lanes << " lanes");
+    wave.parked = LaneMask();
+    wave.calling = LaneMask();
+    wave.grouped = lanes > 1;
+    wave.schedulerMxcsr = _mm_getcsr();
+    for (size_t i = 0; i < lanes; ++i) wave.lanes[i].failure = nullptr;
+}
+
 namespace {
+
+// The MXCSR of the code that runs while it lives, put back when it ends.
+class MxcsrScope {
+public:
+    explicit MxcsrScope(uint32_t mxcsr) : saved_(_mm_getcsr()) { set(mxcsr); }
+    ~MxcsrScope() { set(saved_); }
+    MxcsrScope(const MxcsrScope&) = delete;
+    MxcsrScope& operator=(const MxcsrScope&) = delete;
+
+private:
+    static void set(uint32_t mxcsr) {
+        if (_mm_getcsr() != mxcsr) _mm_setcsr(mxcsr);
+    }
+    uint32_t saved_;
+};
+
+}  // namespace
+
+void runWave(Wave& wave, std::span<const uvec3> launches, const LaunchFunction& launch) {
+    openWave(wave, launches.size());
+    for (size_t i = 0; i < launches.size(); ++i) {
+        WaveLane& lane = wave.lanes[i];
+        lane.launch = launches[i];
+        laneFiber(wave, int(i)).start([&launch, &lane] { launch(lane.ts, lane.launch); });  // two pointers: no allocation
+    }
+    runLanes(wave, LaneMask::first(int(launches.size())));
+}
+
+namespace {
+
+// One lane's TraceRay in a wave's traceRaysInWave: its call, ray and payload copy, and where its failure goes.
+struct LaneTrace {
+    Invocation* caller = nullptr;
+    const TraceRayCall* call = nullptr;
+    RayState rs;
+    std::optional<ValueCopy> payload;
+    std::exception_ptr* failure = nullptr;
+    // The rest of the lane's TraceRay (its closest-hit or miss shader, TraceRayEnd, the payload back), keeping what
+    // stops the lane's launch for its wave shader.
+    void finish() {
+        try {
+            finishTraceRay(*caller, *call, rs, *payload);
+        } catch (...) {
+            *failure = std::current_exception();
+        }
+    }
+};
+
+}  // namespace
+
+void traceRaysInWave(Wave& wave, const std::array<Invocation*, kMaxWaveWidth>& callers,
+                     const std::array<TraceRayCall, kMaxWaveWidth>& calls, LaneMask lanes,
+                     std::array<std::exception_ptr, kMaxWaveWidth>& failures) {
+    std::array<LaneTrace, kMaxWaveWidth> traces;
+    LaneMask packet, invoked;
+    for (int i : lanes) {
+        LaneTrace& t = traces[size_t(i)];
+        t.caller = callers[size_t(i)];
+        t.call = &calls[size_t(i)];
+        t.failure = &failures[size_t(i)];
+        try {
+            switch (beginTraceRay(*t.caller, *t.call, t.rs, t.payload)) {
+                case TraceRayStart::Ended: continue;
+                case TraceRayStart::Traverse: packet.set(i); break;
+                case TraceRayStart::Invoke: break;
+            }
+            invoked.set(i);
+        } catch (...) {
+            failures[size_t(i)] = std::current_exception();
+        }
+    }
+    if (packet.any()) {
+        // The packet traverses in the scheduler's floating-point mode, as the packets of parked lanes do.
+        const MxcsrScope scheduling(wave.schedulerMxcsr);
+        for (int i : packet) {
+            WaveLane& lane = wave.lanes[size_t(i)];
+            lane.ray = &traces[size_t(i)].rs;
+            lane.site = siteOf(*traces[size_t(i)].caller);
+        }
+        traversePacket(wave, packet);
+        for (int i : packet) {
+            WaveLane& lane = wave.lanes[size_t(i)];
+            lane.ray = nullptr;
+            if (lane.failure) {
+                failures[size_t(i)] = std::move(lane.failure);
+                lane.failure = nullptr;
+                invoked.clear(i);
+            }
+        }
+    }
+    // The closest-hit shaders run on their lanes' fibers, which start in the caller's floating-point mode, since they
+    // may trace rays of their own (parked and traversed together as the lanes of any wave). A lane without one (a
+    // miss shader, or none: a miss, SKIP_CLOSEST_HIT_SHADER) finishes here, on the wave's stack: a TraceRay from its
+    // miss shader traverses at once (awaitTraversal).
+    LaneMask onFibers;
+    for (int i : invoked) {
+        LaneTrace& t = traces[size_t(i)];
+        if (t.rs.committed && !(t.rs.effectiveFlags & RAY_FLAG_SKIP_CLOSEST_HIT_SHADER)) {
+            laneFiber(wave, i).start([&t] { t.finish(); });  // one pointer: no allocation
+            onFibers.set(i);
+        } else {
+            t.finish();
+        }
+    }
+    if (onFibers.any()) {
+        const MxcsrScope scheduling(wave.schedulerMxcsr);
+        runLanes(wave, onFibers);
+    }
+}
+
+namespace {
+
+// Whether the caller runs on `lane`'s own fiber (and may park there), not on the wave's stack.
+bool onOwnFiber(const WaveLane& lane) {
+    const Fiber* own = lane.wave->fibers[size_t(lane.index)].get();
+    return own && Fiber::current() == own;
+}
 
 // Rethrows, on the lane's fiber, what stopped the lane while it waited.
 void rethrowFailure(WaveLane& lane) {
@@ -83,18 +209,26 @@ void rethrowFailure(WaveLane& lane) {
 
 void awaitTraversal(ThreadState& ts, RayState& rs, const Site& site) {
     WaveLane* lane = ts.lane;
-    REFRAY_ASSERT(lane && Fiber::current(), "a TraceRay outside a wave lane");
+    REFRAY_ASSERT(lane, "a TraceRay outside a wave lane");
+    Wave& wave = *lane->wave;
     lane->ray = &rs;
     lane->site = site;
-    lane->wave->parked.set(lane->index);
-    Fiber::yield();
+    if (onOwnFiber(*lane)) {
+        wave.parked.set(lane->index);
+        Fiber::yield();
+    } else {
+        // Off its lane's fiber (a miss shader that traceRaysInWave finishes on the wave's stack): the ray traverses at
+        // once, a packet of one, in the scheduler's floating-point mode.
+        const MxcsrScope scheduling(wave.schedulerMxcsr);
+        traversePacket(wave, LaneMask::only(lane->index));
+    }
     lane->ray = nullptr;
     rethrowFailure(*lane);
 }
 
 void awaitWaveCall(ThreadState& ts, const WaveFunction& function, const WaveCallKey& key, void* state) {
     WaveLane* lane = ts.lane;
-    if (!lane || !lane->wave->grouped || Fiber::current() != lane->wave->fibers[size_t(lane->index)].get()) {
+    if (!lane || !lane->wave->grouped || !onOwnFiber(*lane)) {
         void* const alone[] = {state};
         function.run(std::span<void* const>(alone, 1));
         return;

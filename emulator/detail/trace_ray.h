@@ -2,15 +2,29 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 
 #include "emulator/detail/invocation.h"
+#include "emulator/detail/shader_invocation.h"
+#include "emulator/trace_ray_call.h"
 
 namespace refray::dxr::detail {
 
 // TraceRay (sections 4-10) from the shader `caller`: validation, candidate gathering, the TRV-4 loop, then the
 // closest-hit or miss shader. The payload is copied in and out (RAY-9).
-void traceRay(Invocation& caller, GpuVirtualAddress asAddress, uint32_t rayFlags, uint32_t mask, uint32_t r,
-              uint32_t m, uint32_t missIndex, const RayDesc& ray, void* payload, TypeTag payloadType);
+void traceRay(Invocation& caller, const TraceRayCall& call);
+
+// TraceRay in its two halves, around the traversal, for a wave that traces its lanes' rays together
+// (detail/wave.h, traceRaysInWave). beginTraceRay checks the arguments (LIM-2, RAY-10, FLAG-2..5, RAY-5, RAY-7,
+// IDX-2), fills `rs`, copies the payload in (RAY-9), emits and counts the ray and finds its TLAS. Ended: the call
+// ends there (an argument error, or no TLAS: no shader runs, the payload stays as it was); Traverse: the ray's
+// candidates are to be gathered and processed (TRV-4) before finishTraceRay; Invoke: straight to finishTraceRay (a
+// null acceleration structure, RAY-3, or a ray outside the traversal's range, RAY-7).
+enum class TraceRayStart { Ended, Traverse, Invoke };
+TraceRayStart beginTraceRay(Invocation& caller, const TraceRayCall& call, RayState& rs,
+                            std::optional<ValueCopy>& payload);
+// The closest-hit or miss shader (TRV-5, TRV-6), the TraceRayEnd event and the payload copied back.
+void finishTraceRay(Invocation& caller, const TraceRayCall& call, RayState& rs, ValueCopy& payload);
 
 struct Site;
 

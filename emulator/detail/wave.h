@@ -18,6 +18,7 @@
 #include "emulator/detail/thread_state.h"
 #include "emulator/fiber.h"
 #include "emulator/lane_mask.h"
+#include "emulator/trace_ray_call.h"
 #include "emulator/wave_call.h"
 
 namespace refray::dxr::detail {
@@ -59,6 +60,9 @@ struct Wave {
     LaneMask parked;   // lanes whose TraceRay waits for the packet
     LaneMask calling;  // lanes waiting on a wave call
     bool grouped = false;  // more than one lane: a wave call parks its lane
+    // The MXCSR of the wave's own code (traversal, record groups), which its lanes' shaders may change for theirs:
+    // what the worker thread had when the wave opened.
+    uint32_t schedulerMxcsr = 0;
 };
 
 // Runs one launch on a lane's ThreadState (the dispatcher's launch: the ray generation or compute shader).
@@ -66,6 +70,20 @@ using LaunchFunction = std::function<void(ThreadState&, uvec3)>;
 
 // Runs `launches` (at most kMaxWaveWidth) as the lanes of `wave`, until every lane is done.
 void runWave(Wave& wave, std::span<const uvec3> launches, const LaunchFunction& launch);
+
+// Opens a round of `lanes` lanes (at most kMaxWaveWidth) that the caller runs itself, as a ray generation shader
+// written for waves does (the dispatcher's runLaunchWave): no lane waits, and the wave's own code will run in the
+// floating-point mode of this moment.
+void openWave(Wave& wave, size_t lanes);
+
+// The TraceRays of `lanes`, one per lane, issued together by a shader written for waves that runs on the wave's own
+// stack (ray_generation_wave.h): lane i's is calls[i] from the invocation callers[i]. Each lane's TraceRay is the one
+// ShaderContext::TraceRay makes (the same checks, events, counts, candidates, shaders and payload), and their rays
+// traverse as one packet. Closest-hit shaders run on their lanes' fibers (their own TraceRays park as any lane's);
+// miss shaders on the wave's stack. What stops a lane's launch goes to failures[i].
+void traceRaysInWave(Wave& wave, const std::array<Invocation*, kMaxWaveWidth>& callers,
+                     const std::array<TraceRayCall, kMaxWaveWidth>& calls, LaneMask lanes,
+                     std::array<std::exception_ptr, kMaxWaveWidth>& failures);
 
 // TraceRay's traversal for `rs` (TRV-4: its candidates gathered, ordered and processed), which the caller's wave
 // runs in a packet with the other lanes' rays; returns when the ray's search is over. Rethrows what stopped the

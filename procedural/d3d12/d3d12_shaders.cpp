@@ -8,6 +8,7 @@
 #include <type_traits>
 
 #include "emulator/intersection_wave.h"
+#include "emulator/ray_generation_wave.h"
 #include "emulator/shader_api.h"
 #include "procedural/math/analytic.h"
 #include "procedural/math/hlsl.h"
@@ -432,17 +433,31 @@ PrimitiveHit<T> IntersectPrimitiveInWave(const ShaderContext& ctx, IntersectionS
 // PORT: MAX_RAY_RECURSION_DEPTH is the library's `maxDepth` (maxRayRecursionDepth of its Accuracy), passed down
 // the same way; so is the library's Effects, whose traceShadowRays false makes every shadow call site return "not in
 // shadow" untraced, as at that depth.
+// PORT: TraceRadianceRay up to its TraceRay: false at MAX_RAY_RECURSION_DEPTH (no ray: black); else `rayPayload`
+// initialised and `call` the TraceRay with it, for the caller to make (alone, or with a wave's other lanes).
+template <typename T>
+bool RadianceRayCall(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
+                     const tvec3<T>& origin, const tvec3<T>& direction, uint32_t currentRayRecursionDepth,
+                     RayPayload& rayPayload, TraceRayCall& call) {
+    if (currentRayRecursionDepth >= maxDepth) return false;
+    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
+    rayPayload = RayPayload{vec4(0.0f), currentRayRecursionDepth + 1};
+    const TraceRayArguments& radiance = traceRay[RayType::Radiance];
+    call = traceRayCall(ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[RayType::Radiance],
+                        radiance.instanceInclusionMask, /*HitGroup::Offset*/ radiance.rayContribution,
+                        /*HitGroup::GeometryStride*/ radiance.multiplier,
+                        /*MissShader::Offset*/ radiance.missShaderIndex, rayDesc, rayPayload);
+    return true;
+}
+
 template <typename T>
 tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
                           const tvec3<T>& origin, const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
-    if (currentRayRecursionDepth >= maxDepth) return tvec4<T>(T(0));
-    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
-    RayPayload rayPayload{vec4(0.0f), currentRayRecursionDepth + 1};
-    const TraceRayArguments& radiance = traceRay[RayType::Radiance];
-    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[RayType::Radiance],
-                 radiance.instanceInclusionMask, /*HitGroup::Offset*/ radiance.rayContribution,
-                 /*HitGroup::GeometryStride*/ radiance.multiplier, /*MissShader::Offset*/ radiance.missShaderIndex,
-                 rayDesc, rayPayload);
+    RayPayload rayPayload{};
+    TraceRayCall call;
+    if (!RadianceRayCall(ctx, traceRay, maxDepth, origin, direction, currentRayRecursionDepth, rayPayload, call))
+        return tvec4<T>(T(0));
+    ctx.TraceRay(call);
     return tvec4<T>(rayPayload.color);
 }
 
@@ -634,20 +649,33 @@ tvec4<T> ReflectedColor(ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
 // trace rays take the library's TraceRay arguments, and those that march or recurse its Accuracy (PORT: constants
 // in the HLSL); those that trace shadow rays take its Effects.
 
+// PORT: written for waves (emulator/ray_generation_wave.h): each lane runs the HLSL up to its TraceRay, the wave's
+// lanes trace their rays together, then each lane writes its pixel. Lane by lane it is the HLSL's code.
 template <typename T>
-void MyRaygenShader(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy) {
+void MyRaygenShader(RayGenerationWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy) {
     [[maybe_unused]] PrecisionScope<T> scope;
-    const uvec3 index = ctx.DispatchRaysIndex();
-    const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
-    tvec3<T> origin, direction;
-    GenerateCameraRay(uvec2(index), uvec2(ctx.DispatchRaysDimensions()), tvec3<T>(vec3(g_sceneCB.cameraPosition)),
-                      g_sceneCB.projectionToWorld, origin, direction);
-    const uint32_t currentRecursionDepth = 0;
-    const tvec4<T> color =
-        TraceRadianceRay(ctx, traceRay, maxRayRecursionDepth(accuracy), origin, direction, currentRecursionDepth);
-    // PORT: the texture stores floats; the R8G8B8A8_UNORM conversion (clamp, round, NaN -> 0) happens when the
-    // image is written out (H20).
-    ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView)).at(index.x, index.y) = vec4(color);
+    std::array<RayPayload, kMaxWaveWidth> rayPayload{};
+    std::array<TraceRayCall, kMaxWaveWidth> calls{};
+    LaneMask tracing;
+    wave.forEachLane([&](int i, ShaderContext& ctx) {
+        const uvec3 index = ctx.DispatchRaysIndex();
+        const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
+        tvec3<T> origin, direction;
+        GenerateCameraRay(uvec2(index), uvec2(ctx.DispatchRaysDimensions()), tvec3<T>(vec3(g_sceneCB.cameraPosition)),
+                          g_sceneCB.projectionToWorld, origin, direction);
+        const uint32_t currentRecursionDepth = 0;
+        if (RadianceRayCall(ctx, traceRay, maxRayRecursionDepth(accuracy), origin, direction, currentRecursionDepth,
+                            rayPayload[size_t(i)], calls[size_t(i)]))
+            tracing.set(i);
+    });
+    wave.TraceRay(tracing, calls);
+    wave.forEachLane([&](int i, ShaderContext& ctx) {
+        const uvec3 index = ctx.DispatchRaysIndex();
+        const tvec4<T> color = tracing.test(i) ? tvec4<T>(rayPayload[size_t(i)].color) : tvec4<T>(T(0));
+        // PORT: the texture stores floats; the R8G8B8A8_UNORM conversion (clamp, round, NaN -> 0) happens when the
+        // image is written out (H20).
+        ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView)).at(index.x, index.y) = vec4(color);
+    });
 }
 
 template <typename T>
@@ -912,9 +940,9 @@ template <typename T>
 void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
                 const Effects& effects, const std::optional<Perturbation>& perturbation) {
     const auto in = [&perturbation](auto entry) { return withArithmetic<T>(perturbation, entry); };
-    lib.addRayGeneration("MyRaygenShader", in([traceRay, accuracy](ShaderContext& ctx) {
-                             MyRaygenShader<T>(ctx, traceRay, accuracy);
-                         }));
+    lib.addWaveRayGeneration("MyRaygenShader", in([traceRay, accuracy](RayGenerationWave& wave) {
+                                 MyRaygenShader<T>(wave, traceRay, accuracy);
+                             }));
     // The sample's closest hits, and the inline-shadow variants of scenes/inline/InlineShadows.hlsl.
     for (const ShadowTracing tracing : {ShadowTracing::TraceRay, ShadowTracing::Inline}) {
         const std::string suffix = tracing == ShadowTracing::Inline ? "_InlineShadow" : "";

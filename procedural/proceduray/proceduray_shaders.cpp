@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "emulator/intersection_wave.h"
+#include "emulator/ray_generation_wave.h"
 #include "emulator/shader_api.h"
 #include "procedural/math/fractals.h"
 #include "procedural/math/hlsl.h"
@@ -272,17 +273,31 @@ math::RayExtent<T> CurrentExtent(const ShaderContext& ctx) {
 // PORT: MAX_RAY_RECURSION_DEPTH is the library's `maxDepth` (maxRayRecursionDepth of its Accuracy), passed down
 // the same way; so is the library's Effects, whose traceShadowRays false makes every shadow call site return "not in
 // shadow" untraced, as at that depth.
+// PORT: TraceRadianceRay up to its TraceRay: false at MAX_RAY_RECURSION_DEPTH (no ray: black); else `rayPayload`
+// initialised and `call` the TraceRay with it, for the caller to make (alone, or with a wave's other lanes).
+template <typename T>
+bool RadianceRayCall(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
+                     const tvec3<T>& origin, const tvec3<T>& direction, uint32_t currentRayRecursionDepth,
+                     RayPayload& rayPayload, TraceRayCall& call) {
+    if (currentRayRecursionDepth >= maxDepth) return false;
+    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
+    rayPayload = RayPayload{vec4(0.0f), currentRayRecursionDepth + 1, 0.0f, 0, 0};
+    const TraceRayArguments& radiance = traceRay[Radiance];
+    call = traceRayCall(ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[Radiance],
+                        radiance.instanceInclusionMask, /*RayContributionToHitGroupIndex*/ radiance.rayContribution,
+                        /*MultiplierForGeometryContribution*/ radiance.multiplier,
+                        /*MissShaderIndex*/ radiance.missShaderIndex, rayDesc, rayPayload);
+    return true;
+}
+
 template <typename T>
 tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
                           const tvec3<T>& origin, const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
-    if (currentRayRecursionDepth >= maxDepth) return tvec4<T>(T(0));
-    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
-    RayPayload rayPayload{vec4(0.0f), currentRayRecursionDepth + 1, 0.0f, 0, 0};
-    const TraceRayArguments& radiance = traceRay[Radiance];
-    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[Radiance],
-                 radiance.instanceInclusionMask, /*RayContributionToHitGroupIndex*/ radiance.rayContribution,
-                 /*MultiplierForGeometryContribution*/ radiance.multiplier,
-                 /*MissShaderIndex*/ radiance.missShaderIndex, rayDesc, rayPayload);
+    RayPayload rayPayload{};
+    TraceRayCall call;
+    if (!RadianceRayCall(ctx, traceRay, maxDepth, origin, direction, currentRayRecursionDepth, rayPayload, call))
+        return tvec4<T>(T(0));
+    ctx.TraceRay(call);
     return tvec4<T>(rayPayload.color);
 }
 
@@ -342,19 +357,32 @@ constexpr ProceduralPrimitiveAttributes kInitialAttributes{vec3(0.0f), vec4(0.0f
 // trace rays take the library's TraceRay arguments, and those that march or recurse its Accuracy (PORT: constants
 // in the HLSL); those that trace shadow rays take its Effects.
 
+// PORT: written for waves (emulator/ray_generation_wave.h): each lane runs the HLSL up to its TraceRay, the wave's
+// lanes trace their rays together, then each lane writes its pixel. Lane by lane it is the HLSL's code.
 template <typename T>
-void Raygen(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy) {
+void Raygen(RayGenerationWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy) {
     [[maybe_unused]] PrecisionScope<T> scope;
-    const uvec3 index = ctx.DispatchRaysIndex();
-    const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
-    tvec3<T> origin, direction;
-    GenerateCameraRay(uvec2(index), uvec2(ctx.DispatchRaysDimensions()), tvec3<T>(g_sceneCB.cameraPosition),
-                      g_sceneCB.projectionToWorld, origin, direction);
-    const uint32_t currentRecursionDepth = 0;
-    const tvec4<T> color =
-        TraceRadianceRay(ctx, traceRay, maxRayRecursionDepth(accuracy), origin, direction, currentRecursionDepth);
-    // PORT: the texture stores floats; the R8G8B8A8_UNORM conversion happens when the image is written out.
-    ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView)).at(index.x, index.y) = vec4(color);
+    std::array<RayPayload, kMaxWaveWidth> rayPayload{};
+    std::array<TraceRayCall, kMaxWaveWidth> calls{};
+    LaneMask tracing;
+    wave.forEachLane([&](int i, ShaderContext& ctx) {
+        const uvec3 index = ctx.DispatchRaysIndex();
+        const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
+        tvec3<T> origin, direction;
+        GenerateCameraRay(uvec2(index), uvec2(ctx.DispatchRaysDimensions()), tvec3<T>(g_sceneCB.cameraPosition),
+                          g_sceneCB.projectionToWorld, origin, direction);
+        const uint32_t currentRecursionDepth = 0;
+        if (RadianceRayCall(ctx, traceRay, maxRayRecursionDepth(accuracy), origin, direction, currentRecursionDepth,
+                            rayPayload[size_t(i)], calls[size_t(i)]))
+            tracing.set(i);
+    });
+    wave.TraceRay(tracing, calls);
+    wave.forEachLane([&](int i, ShaderContext& ctx) {
+        const uvec3 index = ctx.DispatchRaysIndex();
+        const tvec4<T> color = tracing.test(i) ? tvec4<T>(rayPayload[size_t(i)].color) : tvec4<T>(T(0));
+        // PORT: the texture stores floats; the R8G8B8A8_UNORM conversion happens when the image is written out.
+        ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView)).at(index.x, index.y) = vec4(color);
+    });
 }
 
 void Miss(ShaderContext&, RayPayload& rayPayload) {
@@ -442,9 +470,23 @@ LaneInput<T> readLane(const ShaderContext& ctx) {
 // ReportHit(0, 1, attr); return; }` per lane; the lanes that go on march (and only they call libm: LiveLanes).
 template <typename T>
 struct ProceduralWave {
+    // The lanes' inputs are read in place (a wave's are about 4 KB), then the debug lanes report their hit.
+    explicit ProceduralWave(IntersectionWave& wave)
+        : in(gatherLanes(wave, [](ShaderContext& ctx) { return readLane<T>(ctx); })),
+          marching(openLanes(wave, in)),
+          live(marching.bits(), 0) {}
     std::array<LaneInput<T>, kMaxWaveWidth> in;
     LaneMask marching;
     math::LiveLanes live;
+    static LaneMask openLanes(IntersectionWave& wave, const std::array<LaneInput<T>, kMaxWaveWidth>& in) {
+        LaneMask marching;
+        for (int i = 0; i < kMaxWaveWidth; ++i) {
+            if (!wave.isActive(i)) continue;
+            if (in[size_t(i)].sceneCB.debugFlag) wave.ReportHit(i, 0.0f, 1, kInitialAttributes);
+            else marching.set(i);
+        }
+        return marching;
+    }
     // What the group's lanes share (its record and constants): the first marching lane's.
     const LaneInput<T>& group() const { return in[size_t(marching.lowest())]; }
     template <typename L>
@@ -470,14 +512,7 @@ struct ProceduralWave {
 
 template <typename T>
 ProceduralWave<T> openProceduralWave(IntersectionWave& wave) {
-    const auto in = gatherLanes(wave, [](ShaderContext& ctx) { return readLane<T>(ctx); });
-    LaneMask marching;
-    for (int i = 0; i < kMaxWaveWidth; ++i) {
-        if (!wave.isActive(i)) continue;
-        if (in[size_t(i)].sceneCB.debugFlag) wave.ReportHit(i, 0.0f, 1, kInitialAttributes);
-        else marching.set(i);
-    }
-    return {in, marching, math::LiveLanes(marching.bits(), 0)};
+    return ProceduralWave<T>(wave);
 }
 
 template <typename T, typename L>
@@ -704,8 +739,8 @@ template <typename T>
 void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
                 const Effects& effects, const std::optional<Perturbation>& perturbation) {
     const auto in = [&perturbation](auto entry) { return withArithmetic<T>(perturbation, entry); };
-    lib.addRayGeneration("Raygen",
-                         in([traceRay, accuracy](ShaderContext& ctx) { Raygen<T>(ctx, traceRay, accuracy); }));
+    lib.addWaveRayGeneration(
+        "Raygen", in([traceRay, accuracy](RayGenerationWave& wave) { Raygen<T>(wave, traceRay, accuracy); }));
     lib.addMiss<RayPayload>("Miss", Miss);
     lib.addMiss<ShadowRayPayload>("Miss_Shadow", Miss_Shadow);
     lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
