@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/math.h"
+#include "emulator/ray_generation_wave.h"
 #include "emulator/root_signature.h"
 #include "procedural/math/hlsl.h"
 
@@ -100,6 +101,57 @@ void GenerateCameraRay(uvec2 index, uvec2 dimensions, glm::vec<3, T> cameraPosit
     const glm::vec<3, T> worldXYZ = glm::vec<3, T>(world) / world.w;
     origin = cameraPosition;
     direction = hlsl::normalize(worldXYZ - origin);
+}
+
+// A radiance ray traced alone: `makeCall(payload, call)` builds the TraceRay (false: it makes none, and the result is
+// black), which runs before the payload's colour is returned (the samples' TraceRadianceRay around their
+// RadianceRayCall).
+template <typename T, class Payload, class MakeCall>
+glm::vec<4, T> TracePayloadColor(dxr::ShaderContext& ctx, MakeCall makeCall) {
+    Payload payload{};
+    dxr::TraceRayCall call;
+    if (!makeCall(payload, call)) return glm::vec<4, T>(T(0));
+    ctx.TraceRay(call);
+    return glm::vec<4, T>(payload.color);
+}
+
+// The camera and output texture a ray generation shader reads: what CameraRaygen's `camera` gives for a lane.
+template <typename T>
+struct CameraSetup {
+    glm::vec<3, T> cameraPosition;
+    Float4x4 projectionToWorld;
+};
+
+// The ray generation shader both samples share (D3D12's MyRaygenShader, Proceduray's Raygen), written for waves
+// (emulator/ray_generation_wave.h): each lane reads its camera (`camera(ctx)`: the lane's scene constants), builds its
+// camera ray (GenerateCameraRay) and its radiance TraceRay (`radianceCall(ctx, origin, direction,
+// currentRecursionDepth, payload, call)`: false at MAX_RAY_RECURSION_DEPTH, which leaves the pixel black), the
+// wave's lanes trace together, then each lane writes its colour to the output UAV of descriptor table
+// `outputTable`. Lane by lane it is the HLSL's code.
+// PORT: the texture stores floats; the R8G8B8A8_UNORM conversion (clamp, round, NaN -> 0) happens when the image is
+// written out (H20).
+template <typename T, class Payload, class Camera, class RadianceCall>
+void CameraRaygen(dxr::RayGenerationWave& wave, uint32_t outputTable, Camera camera, RadianceCall radianceCall) {
+    std::array<Payload, dxr::kMaxWaveWidth> rayPayload{};
+    std::array<dxr::TraceRayCall, dxr::kMaxWaveWidth> calls{};
+    dxr::LaneMask tracing;
+    wave.forEachLane([&](int i, dxr::ShaderContext& ctx) {
+        const uvec3 index = ctx.DispatchRaysIndex();
+        const CameraSetup<T> setup = camera(ctx);
+        glm::vec<3, T> origin, direction;
+        GenerateCameraRay(uvec2(index), uvec2(ctx.DispatchRaysDimensions()), setup.cameraPosition,
+                          setup.projectionToWorld, origin, direction);
+        const uint32_t currentRecursionDepth = 0;
+        if (radianceCall(ctx, origin, direction, currentRecursionDepth, rayPayload[size_t(i)], calls[size_t(i)]))
+            tracing.set(i);
+    });
+    wave.TraceRay(tracing, calls);
+    wave.forEachLane([&](int i, dxr::ShaderContext& ctx) {
+        const uvec3 index = ctx.DispatchRaysIndex();
+        const glm::vec<4, T> color =
+            tracing.test(i) ? glm::vec<4, T>(rayPayload[size_t(i)].color) : glm::vec<4, T>(T(0));
+        ctx.rwTexture2D(ctx.globalDescriptorTable(outputTable)).at(index.x, index.y) = vec4(color);
+    });
 }
 
 // The index triplet inside the 8 bytes a ByteAddressBuffer Load2 read at the dword-aligned

@@ -1,9 +1,11 @@
 #include "procedural/builtin/builtin_shaders.h"
 
+#include <array>
 #include <cmath>
 
 #include "core/ray_offset.h"
 #include "emulator/intersection_wave.h"
+#include "emulator/ray_generation_wave.h"
 #include "emulator/shader_api.h"
 #include "procedural/wave_shader.h"
 
@@ -35,11 +37,22 @@ SceneConstants sceneConstants(ShaderContext& ctx) {
 
 vec3 hitWorldPosition(ShaderContext& ctx) { return ctx.WorldRayOrigin() + ctx.RayTCurrent() * ctx.WorldRayDirection(); }
 
+// traceRadiance up to its TraceRay: false at the recursion limit (black, no ray); else `payload` initialised and
+// `call` the TraceRay with it, for the caller to make (alone, or with a wave's other lanes).
+bool radianceCall(ShaderContext& ctx, const RayDesc& ray, uint32_t depth, RadiancePayload& payload,
+                  TraceRayCall& call) {
+    if (depth >= kMaxRecursionDepth) return false;
+    payload = RadiancePayload{vec4(0.0f), depth + 1};
+    call = traceRayCall(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_CULL_BACK_FACING_TRIANGLES, 0xFF,
+                        0, kRayTypeCount, 0, ray, payload);
+    return true;
+}
+
 vec4 traceRadiance(ShaderContext& ctx, const RayDesc& ray, uint32_t depth) {
-    if (depth >= kMaxRecursionDepth) return vec4(0.0f);
-    RadiancePayload payload{vec4(0.0f), depth + 1};
-    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_CULL_BACK_FACING_TRIANGLES, 0xFF, 0,
-                 kRayTypeCount, 0, ray, payload);
+    RadiancePayload payload{};
+    TraceRayCall call;
+    if (!radianceCall(ctx, ray, depth, payload, call)) return vec4(0.0f);
+    ctx.TraceRay(call);
     return payload.color;
 }
 
@@ -99,12 +112,25 @@ std::string_view toString(SecondaryRayOrigin origin) {
 std::shared_ptr<ShaderLibrary> makeShaderLibrary(SecondaryRayOrigin mode) {
     auto lib = std::make_shared<ShaderLibrary>();
 
-    lib->addRayGeneration("RayGen", [](ShaderContext& ctx) {
-        const uvec3 index = ctx.DispatchRaysIndex();
-        const SceneConstants sc = sceneConstants(ctx);
-        const vec3 d = primaryDirection(sc, index, ctx.DispatchRaysDimensions());
-        const vec4 color = traceRadiance(ctx, RayDesc{vec3(sc.cameraPosition), 0.001f, d, kTMax}, 0);
-        ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputTable)).at(index.x, index.y) = color;
+    // Written for waves (emulator/ray_generation_wave.h): each lane computes its camera ray, the wave's lanes trace
+    // them together, then each lane writes its pixel.
+    lib->addWaveRayGeneration("RayGen", [](RayGenerationWave& wave) {
+        std::array<RadiancePayload, kMaxWaveWidth> payloads{};
+        std::array<TraceRayCall, kMaxWaveWidth> calls{};
+        LaneMask tracing;
+        wave.forEachLane([&](int i, ShaderContext& ctx) {
+            const SceneConstants sc = sceneConstants(ctx);
+            const vec3 d = primaryDirection(sc, ctx.DispatchRaysIndex(), ctx.DispatchRaysDimensions());
+            if (radianceCall(ctx, RayDesc{vec3(sc.cameraPosition), 0.001f, d, kTMax}, 0, payloads[size_t(i)],
+                             calls[size_t(i)]))
+                tracing.set(i);
+        });
+        wave.TraceRay(tracing, calls);
+        wave.forEachLane([&](int i, ShaderContext& ctx) {
+            const uvec3 index = ctx.DispatchRaysIndex();
+            const vec4 color = tracing.test(i) ? payloads[size_t(i)].color : vec4(0.0f);
+            ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputTable)).at(index.x, index.y) = color;
+        });
     });
 
     lib->addMiss<RadiancePayload>("Miss", [](ShaderContext& ctx, RadiancePayload& payload) {

@@ -293,12 +293,9 @@ bool RadianceRayCall(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, ui
 template <typename T>
 tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
                           const tvec3<T>& origin, const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
-    RayPayload rayPayload{};
-    TraceRayCall call;
-    if (!RadianceRayCall(ctx, traceRay, maxDepth, origin, direction, currentRayRecursionDepth, rayPayload, call))
-        return tvec4<T>(T(0));
-    ctx.TraceRay(call);
-    return tvec4<T>(rayPayload.color);
+    return TracePayloadColor<T, RayPayload>(ctx, [&](RayPayload& rayPayload, TraceRayCall& call) {
+        return RadianceRayCall(ctx, traceRay, maxDepth, origin, direction, currentRayRecursionDepth, rayPayload, call);
+    });
 }
 
 template <typename T>
@@ -357,32 +354,21 @@ constexpr ProceduralPrimitiveAttributes kInitialAttributes{vec3(0.0f), vec4(0.0f
 // trace rays take the library's TraceRay arguments, and those that march or recurse its Accuracy (PORT: constants
 // in the HLSL); those that trace shadow rays take its Effects.
 
-// PORT: written for waves (emulator/ray_generation_wave.h): each lane runs the HLSL up to its TraceRay, the wave's
-// lanes trace their rays together, then each lane writes its pixel. Lane by lane it is the HLSL's code.
+// PORT: written for waves: the samples' shared CameraRaygen (procedural/sample_layout.h).
 template <typename T>
 void Raygen(RayGenerationWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy) {
     [[maybe_unused]] PrecisionScope<T> scope;
-    std::array<RayPayload, kMaxWaveWidth> rayPayload{};
-    std::array<TraceRayCall, kMaxWaveWidth> calls{};
-    LaneMask tracing;
-    wave.forEachLane([&](int i, ShaderContext& ctx) {
-        const uvec3 index = ctx.DispatchRaysIndex();
-        const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
-        tvec3<T> origin, direction;
-        GenerateCameraRay(uvec2(index), uvec2(ctx.DispatchRaysDimensions()), tvec3<T>(g_sceneCB.cameraPosition),
-                          g_sceneCB.projectionToWorld, origin, direction);
-        const uint32_t currentRecursionDepth = 0;
-        if (RadianceRayCall(ctx, traceRay, maxRayRecursionDepth(accuracy), origin, direction, currentRecursionDepth,
-                            rayPayload[size_t(i)], calls[size_t(i)]))
-            tracing.set(i);
-    });
-    wave.TraceRay(tracing, calls);
-    wave.forEachLane([&](int i, ShaderContext& ctx) {
-        const uvec3 index = ctx.DispatchRaysIndex();
-        const tvec4<T> color = tracing.test(i) ? tvec4<T>(rayPayload[size_t(i)].color) : tvec4<T>(T(0));
-        // PORT: the texture stores floats; the R8G8B8A8_UNORM conversion happens when the image is written out.
-        ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView)).at(index.x, index.y) = vec4(color);
-    });
+    const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
+    CameraRaygen<T, RayPayload>(
+        wave, kOutputView,
+        [](ShaderContext& ctx) {
+            const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
+            return CameraSetup<T>{tvec3<T>(g_sceneCB.cameraPosition), g_sceneCB.projectionToWorld};
+        },
+        [&](ShaderContext& ctx, const tvec3<T>& origin, const tvec3<T>& direction, uint32_t depth, RayPayload& payload,
+            TraceRayCall& call) {
+            return RadianceRayCall(ctx, traceRay, maxDepth, origin, direction, depth, payload, call);
+        });
 }
 
 void Miss(ShaderContext&, RayPayload& rayPayload) {
