@@ -4,7 +4,6 @@
 
 #include <cmath>
 #include <cstring>
-#include <string_view>
 
 #include "emulator/detail/candidate_rules.h"
 #include "emulator/detail/record_lookup.h"
@@ -76,19 +75,21 @@ AnyHitOutcome runAnyHit(ThreadState& ts, RayState& rs, const RecordView& record,
     observer(ts)->onEvent(e);
 }
 
-// ReportHit's IS-3 (NaN THit), IS-4 and IS-5 reports (cold: out of the frame of every ReportHit).
-[[gnu::cold, gnu::noinline]] void raiseReportHit(ThreadState& ts, const Site& site, std::string_view rule,
-                                                 const ProgramEntry& group, float tHit, uint32_t hitKind,
-                                                 TypeTag type) {
-    if (rule == "IS-3")
-        raise(ts, site, diag("IS-3", "ReportHit called with a NaN THit; the hit is rejected").value("THit", tHit));
-    else if (rule == "IS-5")
-        raise(ts, site, diag("IS-5", "ReportHit attributes are not the type hit group '" + group.name + "' consumes")
-                            .value("reported", type.name() + " (" + std::to_string(type.size) + " B)")
-                            .value("expected", group.attributes.name() + " (" + std::to_string(group.attributes.size) + " B)"));
-    else
-        raise(ts, site, diag("IS-4", "ReportHit HitKind outside 0..127 (254 and 255 mean triangle faces)")
-                            .value("HitKind", hitKind, "0..127"));
+// ReportHit's IS-3 (NaN THit), IS-5 and IS-4 reports (cold: out of the frame of every ReportHit).
+[[gnu::cold, gnu::noinline]] void raiseNaNTHit(ThreadState& ts, const Site& site, float tHit) {
+    raise(ts, site, diag("IS-3", "ReportHit called with a NaN THit; the hit is rejected").value("THit", tHit));
+}
+
+[[gnu::cold, gnu::noinline]] void raiseAttributeType(ThreadState& ts, const Site& site, const ProgramEntry& group,
+                                                     TypeTag type) {
+    raise(ts, site, diag("IS-5", "ReportHit attributes are not the type hit group '" + group.name + "' consumes")
+                        .value("reported", type.name() + " (" + std::to_string(type.size) + " B)")
+                        .value("expected", group.attributes.name() + " (" + std::to_string(group.attributes.size) + " B)"));
+}
+
+[[gnu::cold, gnu::noinline]] void raiseHitKind(ThreadState& ts, const Site& site, uint32_t hitKind) {
+    raise(ts, site, diag("IS-4", "ReportHit HitKind outside 0..127 (254 and 255 mean triangle faces)")
+                        .value("HitKind", hitKind, "0..127"));
 }
 
 }  // namespace
@@ -100,15 +101,15 @@ bool reportHit(Invocation& inv, float tHit, uint32_t hitKind, const void* attrib
     const ProgramEntry& group = *inv.record->entry;
     if (observer(ts)) emitReportHit(ts, inv, tHit, hitKind, type);
     if (std::isnan(tHit)) {
-        raiseReportHit(ts, site, "IS-3", group, tHit, hitKind, type);
+        raiseNaNTHit(ts, site, tHit);
         return false;
     }
     if (!(type == group.attributes)) {  // IS-5: checked on every call, in range or not
-        raiseReportHit(ts, site, "IS-5", group, tHit, hitKind, type);
+        raiseAttributeType(ts, site, group, type);
         return false;
     }
     if (tHit < rs.ray.TMin || tHit > rs.tCurrent) return false;  // IS-3: closed interval
-    if (hitKind > kMaxProceduralHitKind) raiseReportHit(ts, site, "IS-4", group, tHit, hitKind, type);
+    if (hitKind > kMaxProceduralHitKind) raiseHitKind(ts, site, hitKind);
     HitInfo candidate = *inv.hit;
     candidate.t = tHit;
     candidate.hitKind = hitKind;

@@ -175,9 +175,7 @@ void runLaunch(ThreadState& ts, DispatchState& ds, uvec3 launch) {
     try {
         if (!ds.computeShader) detail::checkGlobalSignature(ts, detail::siteOf(inv), *ds.rayGenRecord.entry);
         detail::invoke(ts, inv, nullptr, nullptr);
-    } catch (const DxrError&) {
-        recordLaunchFailure(ts, ds, inv, std::current_exception());
-    } catch (const Error&) {
+    } catch (const Error&) {  // DxrError too
         recordLaunchFailure(ts, ds, inv, std::current_exception());
     }
 }

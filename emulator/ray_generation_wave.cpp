@@ -17,11 +17,8 @@ void RayGenerationWave::TraceRay(LaneMask lanes, const std::array<TraceRayCall, 
     const LaneMask tracing(lanes.bits() & active_.bits());
     if (!wave_) {
         for (int i : tracing) {
-            const TraceRayCall& c = calls[size_t(i)];
             try {
-                contexts_[size_t(i)]->traceRay(c.accelerationStructure, c.rayFlags, c.instanceInclusionMask,
-                                               c.rayContribution, c.multiplier, c.missShaderIndex, c.ray, c.payload,
-                                               c.payloadType);
+                contexts_[size_t(i)]->TraceRay(calls[size_t(i)]);
             } catch (...) {
                 fail(i, std::current_exception());
             }

@@ -13,6 +13,7 @@
 #include <array>
 #include <exception>
 #include <functional>
+#include <utility>
 
 #include "emulator/lane_mask.h"
 #include "emulator/shader_api.h"
@@ -53,6 +54,21 @@ public:
     // TraceRay for every active lane of `lanes`, lane i's with calls[i] (its payload is lane i's variable, filled in
     // when this returns). Lanes outside `lanes` trace nothing.
     void TraceRay(LaneMask lanes, const std::array<TraceRayCall, kMaxWaveWidth>& calls);
+
+    // The shape of a shader with one TraceRay a launch, over the wave: each active lane runs its code up to the
+    // TraceRay (`before(ctx, payload, call)`: whether the lane traces, with its payload set and its call built),
+    // the lanes' TraceRays run together, then each lane runs its code after it (`after(ctx, payload, traced)`).
+    template <class Payload, class Before, class After>
+    void TraceRayInEachLane(Before&& before, After&& after) {
+        std::array<Payload, kMaxWaveWidth> payloads{};
+        std::array<TraceRayCall, kMaxWaveWidth> calls{};
+        LaneMask tracing;
+        forEachLane([&](int i, ShaderContext& ctx) {
+            if (before(ctx, payloads[size_t(i)], calls[size_t(i)])) tracing.set(i);
+        });
+        TraceRay(tracing, calls);
+        forEachLane([&](int i, ShaderContext& ctx) { after(ctx, std::as_const(payloads[size_t(i)]), tracing.test(i)); });
+    }
 
     // Runs a wave shader for one lane alone (the export's ShaderExport::function): its TraceRay is the lane's
     // ShaderContext::TraceRay, and what stopped the lane is rethrown.

@@ -110,15 +110,14 @@ void ShaderContext::AcceptHitAndEndSearch() {
     throw detail::AcceptHitAndEndSearchSignal{};
 }
 
-void ShaderContext::traceRay(GpuVirtualAddress as, uint32_t flags, uint32_t mask, uint32_t r, uint32_t m, uint32_t miss,
-                             const RayDesc& ray, void* payload, TypeTag payloadType) {
+void ShaderContext::TraceRay(const TraceRayCall& call) {
     requireLive("TraceRay");
     if (!(bit(inv_.stage) & (bit(ShaderStage::RayGeneration) | bit(ShaderStage::ClosestHit) | bit(ShaderStage::Miss))))
         stageError(inv_, "RAY-2", "TraceRay() may not be called from a " + std::string(toString(inv_.stage)) + " shader");
     // Timed here rather than inside detail::traceRay: a cleanup there would lengthen the unwind table that
     // every end-search signal caught in it walks. The shaders it invokes charge their own time.
     const detail::ProfileScope traversal(*inv_.thread, ProfileStage::Traversal);
-    detail::traceRay(inv_, TraceRayCall{as, flags, mask, r, m, miss, ray, payload, payloadType});
+    detail::traceRay(inv_, call);
 }
 
 void ShaderContext::callShader(uint32_t index, void* parameters, TypeTag type) {

@@ -129,16 +129,11 @@ public:
     void TraceRay(GpuVirtualAddress accelerationStructure, uint32_t RayFlags, uint32_t InstanceInclusionMask,
                   uint32_t RayContributionToHitGroupIndex, uint32_t MultiplierForGeometryContributionToHitGroupIndex,
                   uint32_t MissShaderIndex, const RayDesc& Ray, Payload& payload) {
-        traceRay(accelerationStructure, RayFlags, InstanceInclusionMask, RayContributionToHitGroupIndex,
-                 MultiplierForGeometryContributionToHitGroupIndex, MissShaderIndex, Ray, &payload,
-                 typeTag<Payload>());
+        TraceRay(traceRayCall(accelerationStructure, RayFlags, InstanceInclusionMask, RayContributionToHitGroupIndex,
+                              MultiplierForGeometryContributionToHitGroupIndex, MissShaderIndex, Ray, payload));
     }
-
     // The same TraceRay, its arguments held in a TraceRayCall (emulator/trace_ray_call.h).
-    void TraceRay(const TraceRayCall& call) {
-        traceRay(call.accelerationStructure, call.rayFlags, call.instanceInclusionMask, call.rayContribution,
-                 call.multiplier, call.missShaderIndex, call.ray, call.payload, call.payloadType);
-    }
+    void TraceRay(const TraceRayCall& call);
 
     // --- CallShader (CALL-1): ray generation, closest-hit, miss and callable shaders.
     template <class Parameters>
@@ -276,8 +271,6 @@ private:
         return *inv_.hit;
     }
     bool reportHit(float tHit, uint32_t hitKind, const void* attributes, TypeTag type);
-    void traceRay(GpuVirtualAddress as, uint32_t flags, uint32_t mask, uint32_t r, uint32_t m, uint32_t miss,
-                  const RayDesc& ray, void* payload, TypeTag payloadType);
     void callShader(uint32_t index, void* parameters, TypeTag type);
     const uint8_t* rootArgument(bool local, uint32_t parameter, size_t size, TypeTag type) const;
     const uint8_t* rootArgumentChecked(bool local, uint32_t parameter, size_t size, TypeTag type,

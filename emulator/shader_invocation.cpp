@@ -20,9 +20,6 @@ void countInvocation(ThreadState& ts, const ShaderExport* shader) {
     ts.exportCounts.push_back({shader, 1});
 }
 
-}  // namespace
-
-namespace {
 
 // The PIPE-6 and PAY-1 reports (cold: out of the frames of the shader calls that check).
 [[gnu::cold, gnu::noinline]] void raiseGlobalSignature(ThreadState& ts, const Site& site, const ProgramEntry& entry,

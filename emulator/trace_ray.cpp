@@ -60,9 +60,6 @@ std::string vec3Values(const vec3& v) {
     return std::to_string(v.x) + "," + std::to_string(v.y) + "," + std::to_string(v.z);
 }
 
-}  // namespace
-
-namespace {
 
 // validateRay's reports, for a ray that is not plainly valid: out of line, so that the common case's frame (and the
 // frames of TraceRay and RayQuery around it) stays small.
@@ -247,9 +244,6 @@ void runClosestHitOrMiss(ThreadState& ts, RayState& rs, const Site& site) {
     }
 }
 
-}  // namespace
-
-namespace {
 
 // TraceRay's argument reports (cold: out of its frame, which stays with the lane while its closest-hit shader runs).
 [[gnu::cold, gnu::noinline]] void raiseRecursionLimit(ThreadState& ts, const Site& site, uint32_t depth) {

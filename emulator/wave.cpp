@@ -37,7 +37,6 @@ void resumeLanes(Wave& wave, LaneMask lanes) {
     }
 }
 
-
 // Lane i's fiber, made on first use. Lane i's frames start 11*i lines (mod a page) below its stack's top: the lanes'
 // hottest frames spread over the L1 cache's sets instead of sharing them (the stacks' mappings lie whole pages apart).
 Fiber& laneFiber(Wave& wave, int i) {

@@ -132,26 +132,20 @@ struct CameraSetup {
 // written out (H20).
 template <typename T, class Payload, class Camera, class RadianceCall>
 void CameraRaygen(dxr::RayGenerationWave& wave, uint32_t outputTable, Camera camera, RadianceCall radianceCall) {
-    std::array<Payload, dxr::kMaxWaveWidth> rayPayload{};
-    std::array<dxr::TraceRayCall, dxr::kMaxWaveWidth> calls{};
-    dxr::LaneMask tracing;
-    wave.forEachLane([&](int i, dxr::ShaderContext& ctx) {
-        const uvec3 index = ctx.DispatchRaysIndex();
-        const CameraSetup<T> setup = camera(ctx);
-        glm::vec<3, T> origin, direction;
-        GenerateCameraRay(uvec2(index), uvec2(ctx.DispatchRaysDimensions()), setup.cameraPosition,
-                          setup.projectionToWorld, origin, direction);
-        const uint32_t currentRecursionDepth = 0;
-        if (radianceCall(ctx, origin, direction, currentRecursionDepth, rayPayload[size_t(i)], calls[size_t(i)]))
-            tracing.set(i);
-    });
-    wave.TraceRay(tracing, calls);
-    wave.forEachLane([&](int i, dxr::ShaderContext& ctx) {
-        const uvec3 index = ctx.DispatchRaysIndex();
-        const glm::vec<4, T> color =
-            tracing.test(i) ? glm::vec<4, T>(rayPayload[size_t(i)].color) : glm::vec<4, T>(T(0));
-        ctx.rwTexture2D(ctx.globalDescriptorTable(outputTable)).at(index.x, index.y) = vec4(color);
-    });
+    wave.TraceRayInEachLane<Payload>(
+        [&](dxr::ShaderContext& ctx, Payload& rayPayload, dxr::TraceRayCall& call) {
+            const CameraSetup<T> setup = camera(ctx);
+            glm::vec<3, T> origin, direction;
+            GenerateCameraRay(uvec2(ctx.DispatchRaysIndex()), uvec2(ctx.DispatchRaysDimensions()),
+                              setup.cameraPosition, setup.projectionToWorld, origin, direction);
+            const uint32_t currentRecursionDepth = 0;
+            return radianceCall(ctx, origin, direction, currentRecursionDepth, rayPayload, call);
+        },
+        [&](dxr::ShaderContext& ctx, const Payload& rayPayload, bool traced) {
+            const uvec3 index = ctx.DispatchRaysIndex();
+            const glm::vec<4, T> color = traced ? glm::vec<4, T>(rayPayload.color) : glm::vec<4, T>(T(0));
+            ctx.rwTexture2D(ctx.globalDescriptorTable(outputTable)).at(index.x, index.y) = vec4(color);
+        });
 }
 
 // The index triplet inside the 8 bytes a ByteAddressBuffer Load2 read at the dword-aligned

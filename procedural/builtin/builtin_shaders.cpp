@@ -1,6 +1,5 @@
 #include "procedural/builtin/builtin_shaders.h"
 
-#include <array>
 #include <cmath>
 
 #include "core/ray_offset.h"
@@ -115,22 +114,17 @@ std::shared_ptr<ShaderLibrary> makeShaderLibrary(SecondaryRayOrigin mode) {
     // Written for waves (emulator/ray_generation_wave.h): each lane computes its camera ray, the wave's lanes trace
     // them together, then each lane writes its pixel.
     lib->addWaveRayGeneration("RayGen", [](RayGenerationWave& wave) {
-        std::array<RadiancePayload, kMaxWaveWidth> payloads{};
-        std::array<TraceRayCall, kMaxWaveWidth> calls{};
-        LaneMask tracing;
-        wave.forEachLane([&](int i, ShaderContext& ctx) {
-            const SceneConstants sc = sceneConstants(ctx);
-            const vec3 d = primaryDirection(sc, ctx.DispatchRaysIndex(), ctx.DispatchRaysDimensions());
-            if (radianceCall(ctx, RayDesc{vec3(sc.cameraPosition), 0.001f, d, kTMax}, 0, payloads[size_t(i)],
-                             calls[size_t(i)]))
-                tracing.set(i);
-        });
-        wave.TraceRay(tracing, calls);
-        wave.forEachLane([&](int i, ShaderContext& ctx) {
-            const uvec3 index = ctx.DispatchRaysIndex();
-            const vec4 color = tracing.test(i) ? payloads[size_t(i)].color : vec4(0.0f);
-            ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputTable)).at(index.x, index.y) = color;
-        });
+        wave.TraceRayInEachLane<RadiancePayload>(
+            [](ShaderContext& ctx, RadiancePayload& payload, TraceRayCall& call) {
+                const SceneConstants sc = sceneConstants(ctx);
+                const vec3 d = primaryDirection(sc, ctx.DispatchRaysIndex(), ctx.DispatchRaysDimensions());
+                return radianceCall(ctx, RayDesc{vec3(sc.cameraPosition), 0.001f, d, kTMax}, 0, payload, call);
+            },
+            [](ShaderContext& ctx, const RadiancePayload& payload, bool traced) {
+                const uvec3 index = ctx.DispatchRaysIndex();
+                ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputTable)).at(index.x, index.y) =
+                    traced ? payload.color : vec4(0.0f);
+            });
     });
 
     lib->addMiss<RadiancePayload>("Miss", [](ShaderContext& ctx, RadiancePayload& payload) {
