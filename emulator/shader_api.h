@@ -241,7 +241,7 @@ public:
 private:
     friend class RayQueryObject;  // a query belongs to the invocation that made it (emulator/ray_query.h)
     friend class IntersectionWave;  // reads whether a lane's ReportHit ended its search (emulator/intersection_wave.h)
-    friend class RayGenerationWave;  // issues its lanes' TraceRays together (emulator/ray_generation_wave.h)
+    friend class TracingWave;  // issues its lanes' TraceRays together (emulator/tracing_wave.h)
 
     // Stage masks for SV-1.
     static constexpr uint8_t bit(ShaderStage s) { return detail::stageBit(s); }

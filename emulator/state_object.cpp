@@ -8,6 +8,7 @@
 #include <set>
 
 #include "core/strings.h"
+#include "emulator/closest_hit_wave.h"
 #include "emulator/intersection_wave.h"
 #include "emulator/ray_generation_wave.h"
 #include "emulator/limits.h"
@@ -44,6 +45,14 @@ void ShaderLibrary::addWaveRayGeneration(std::string name, WaveRayGenerationShad
     ShaderExport e{std::move(name), ShaderStage::RayGeneration, {}, {}, {},
                    [fn](ShaderContext& c, void*, const void*) { RayGenerationWave::runAlone(fn, c); }};
     e.waveRayGeneration = std::move(fn);
+    add(std::move(e));
+}
+
+void ShaderLibrary::addWaveClosestHit(std::string name, TypeTag payload, TypeTag attributes, WaveClosestHitShader fn) {
+    REFRAY_CHECK(fn, "shader export '" << name << "' has no function");
+    ShaderExport e{std::move(name), ShaderStage::ClosestHit, payload, attributes, {},
+                   [fn](ShaderContext& c, void* p, const void* a) { ClosestHitWave::runAlone(fn, c, p, a); }};
+    e.waveClosestHit = std::move(fn);
     add(std::move(e));
 }
 

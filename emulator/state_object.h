@@ -44,8 +44,10 @@ using ErasedShader = std::function<void(ShaderContext&, void* payload, const voi
 // An intersection shader written for waves (emulator/intersection_wave.h): run once over the lanes of a record group.
 class IntersectionWave;
 class RayGenerationWave;
+class ClosestHitWave;
 using WaveIntersectionShader = std::function<void(IntersectionWave&)>;
 using WaveRayGenerationShader = std::function<void(RayGenerationWave&)>;
+using WaveClosestHitShader = std::function<void(ClosestHitWave&)>;
 
 // How an intersection shader ends when one of its ReportHit calls ends the search (IS-10: FLAG-8, or an any-hit
 // shader's AcceptHitAndEndSearch). docs/emulator.md, "Ending an intersection shader".
@@ -79,6 +81,9 @@ struct ShaderExport {
     int waveLanesPerCall = kMaxWaveWidth;
     // Ray generation written for waves: a wave of launches calls this once; `function` runs it for one lane alone.
     WaveRayGenerationShader waveRayGeneration = {};
+    // Closest hit written for waves: the lanes of a wave whose rays selected it call this once; `function` runs it
+    // for one lane alone.
+    WaveClosestHitShader waveClosestHit = {};
 };
 
 // A DXIL library: named shader exports. Signatures mirror HLSL entry points:
@@ -121,6 +126,13 @@ public:
                  fn(c, *static_cast<Payload*>(p), *static_cast<const Attributes*>(a));
              }});
     }
+    // A closest-hit shader written for waves (emulator/closest_hit_wave.h): one call runs it for the lanes of a wave
+    // whose rays selected it, whose TraceRays it issues together through ClosestHitWave::TraceRay; each lane's
+    // payload and attributes are ClosestHitWave::payload<Payload> and attributes<Attributes>.
+    template <class Payload, class Attributes>
+    void addWaveClosestHit(std::string name, WaveClosestHitShader fn) {
+        addWaveClosestHit(std::move(name), typeTag<Payload>(), typeTag<Attributes>(), std::move(fn));
+    }
     template <class Payload>
     void addMiss(std::string name, std::function<void(ShaderContext&, Payload&)> fn) {
         add({std::move(name), ShaderStage::Miss, typeTag<Payload>(), {}, {},
@@ -142,6 +154,7 @@ private:
     void add(ShaderExport e);
     void addWaveIntersection(std::string name, TypeTag attributes, int lanesPerCall, WaveIntersectionShader fn,
                              ReportHitEnd end);
+    void addWaveClosestHit(std::string name, TypeTag payload, TypeTag attributes, WaveClosestHitShader fn);
     std::map<std::string, ShaderExport> exports_;
 };
 

@@ -219,18 +219,9 @@ bool checkBottomLevelsCurrent(ThreadState& ts, const Site& site, const TopLevelA
 void runClosestHitOrMiss(ThreadState& ts, RayState& rs, const Site& site) {
     const DispatchState& ds = *ts.dispatch;
     if (rs.committed) {
-        if (!(rs.effectiveFlags & RAY_FLAG_SKIP_CLOSEST_HIT_SHADER)) {  // FLAG-9
-            HitInfo& hit = rs.committedHit;
-            const GeometryType type = hit.instance->blas->geometries()[hit.geometryIndex].type;
-            RecordView record;
-            if (lookupHitGroupRecord(ts, site, rs, hit, type, record) && record.entry && record.entry->closestHit) {
-                Invocation inv =
-                    invocation(ts, ShaderStage::ClosestHit, record.entry->closestHit, &record, rs.depth, &rs, &hit);
-                checkGlobalSignature(ts, siteOf(inv), *record.entry);
-                checkPayload(ts, siteOf(inv), *inv.shader, rs.payloadType);
-                invoke(ts, inv, rs.payload, hit.attributes);
-            }
-        }
+        RecordView record;
+        Invocation inv;
+        if (prepareClosestHit(ts, rs, site, record, inv)) invoke(ts, inv, rs.payload, rs.committedHit.attributes);
     } else {
         RecordView record;
         if (lookupRecord(ts, site, ProgramEntry::Kind::Miss, ds.desc->MissShaderTable, missRecordIndex(rs.missShaderIndex),
@@ -243,7 +234,6 @@ void runClosestHitOrMiss(ThreadState& ts, RayState& rs, const Site& site) {
         }
     }
 }
-
 
 // TraceRay's argument reports (cold: out of its frame, which stays with the lane while its closest-hit shader runs).
 [[gnu::cold, gnu::noinline]] void raiseRecursionLimit(ThreadState& ts, const Site& site, uint32_t depth) {
@@ -266,6 +256,24 @@ void runClosestHitOrMiss(ThreadState& ts, RayState& rs, const Site& site) {
 }
 
 }  // namespace
+
+bool prepareClosestHit(ThreadState& ts, RayState& rs, const Site& site, RecordView& record, Invocation& inv) {
+    if (!rs.committed || (rs.effectiveFlags & RAY_FLAG_SKIP_CLOSEST_HIT_SHADER)) return false;  // FLAG-9
+    HitInfo& hit = rs.committedHit;
+    const GeometryType type = hit.instance->blas->geometries()[hit.geometryIndex].type;
+    if (!lookupHitGroupRecord(ts, site, rs, hit, type, record) || !record.entry || !record.entry->closestHit)
+        return false;
+    inv = invocation(ts, ShaderStage::ClosestHit, record.entry->closestHit, &record, rs.depth, &rs, &hit);
+    checkGlobalSignature(ts, siteOf(inv), *record.entry);
+    checkPayload(ts, siteOf(inv), *inv.shader, rs.payloadType);
+    return true;
+}
+
+void endTraceRay(Invocation& caller, const TraceRayCall& call, RayState& rs, ValueCopy& payload) {
+    ThreadState& ts = *caller.thread;
+    if (observer(ts)) emitRay(ts, rs, TraceEvent::Kind::TraceRayEnd, call.accelerationStructure, call.instanceInclusionMask);
+    payload.copyBack(call.payload);
+}
 
 const TopLevelAS* findTopLevelAS(ThreadState& ts, const Site& site, GpuVirtualAddress asAddress) {
     const TopLevelAS* tlas = lookupTopLevelAS(ts, asAddress);
@@ -327,10 +335,8 @@ TraceRayStart beginTraceRay(Invocation& caller, const TraceRayCall& call, RaySta
 }
 
 void finishTraceRay(Invocation& caller, const TraceRayCall& call, RayState& rs, ValueCopy& payload) {
-    ThreadState& ts = *caller.thread;
-    runClosestHitOrMiss(ts, rs, siteOf(caller));
-    if (observer(ts)) emitRay(ts, rs, TraceEvent::Kind::TraceRayEnd, call.accelerationStructure, call.instanceInclusionMask);
-    payload.copyBack(call.payload);
+    runClosestHitOrMiss(*caller.thread, rs, siteOf(caller));
+    endTraceRay(caller, call, rs, payload);
 }
 
 void traceRay(Invocation& caller, const TraceRayCall& call) {

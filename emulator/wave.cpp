@@ -7,6 +7,9 @@
 #include <optional>
 
 #include "core/error.h"
+#include "emulator/closest_hit_wave.h"
+#include "emulator/detail/record_grouping.h"
+#include "emulator/detail/shader_invocation.h"
 #include "emulator/detail/trace_ray.h"
 
 namespace refray::dxr::detail {
@@ -114,8 +117,9 @@ struct LaneTrace {
     RayState rs;
     std::optional<ValueCopy> payload;
     std::exception_ptr* failure = nullptr;
-    // The rest of the lane's TraceRay (its closest-hit or miss shader, TraceRayEnd, the payload back), keeping what
-    // stops the lane's launch for its wave shader.
+    // The rest of the lane's TraceRay, keeping what stops the lane's launch for its wave shader: finish runs its
+    // closest-hit or miss shader and ends it; closestHit runs the closest-hit shader `hit` (prepareClosestHit's) and
+    // ends it; end only ends it (the TraceRayEnd event, the payload back).
     void finish() {
         try {
             finishTraceRay(*caller, *call, rs, *payload);
@@ -123,12 +127,62 @@ struct LaneTrace {
             *failure = std::current_exception();
         }
     }
+    void closestHit(Invocation& hit) {
+        try {
+            invoke(*caller->thread, hit, rs.payload, rs.committedHit.attributes);
+            endTraceRay(*caller, *call, rs, *payload);
+        } catch (...) {
+            *failure = std::current_exception();
+        }
+    }
+    void end() {
+        try {
+            endTraceRay(*caller, *call, rs, *payload);
+        } catch (...) {
+            *failure = std::current_exception();
+        }
+    }
 };
+
+// A closest-hit shader written for waves, run once over `lanes`, the lanes of the wave whose rays selected it (their
+// invocations in `hits`), on the wave's stack; each lane's TraceRay then ends as it ends alone.
+void runClosestHitWave(Wave& wave, const ShaderExport& shader, LaneMask lanes, std::array<LaneTrace, kMaxWaveWidth>& traces,
+                       std::array<Invocation, kMaxWaveWidth>& hits) {
+    std::array<std::optional<ShaderContext>, kMaxWaveWidth> contexts;
+    std::array<ShaderContext*, kMaxWaveWidth> contextOf{};
+    std::array<void*, kMaxWaveWidth> payloads{};
+    std::array<const void*, kMaxWaveWidth> attributes{};
+    std::array<uint8_t, kMaxWaveWidth> callerSections{};
+    for (int i : lanes) {
+        callerSections[size_t(i)] = beginInvocation(*hits[size_t(i)].thread, hits[size_t(i)]);
+        contextOf[size_t(i)] = &contexts[size_t(i)].emplace(hits[size_t(i)]);
+        payloads[size_t(i)] = traces[size_t(i)].rs.payload;
+        attributes[size_t(i)] = traces[size_t(i)].rs.committedHit.attributes;
+    }
+    ClosestHitWave shaderWave(contextOf, lanes, &wave, payloads, attributes);
+    std::exception_ptr escaped;
+    {
+        // The shader's own floating-point mode ends with it, as a lane's does with its fiber.
+        const MxcsrScope callers(_mm_getcsr());
+        try {
+            shader.waveClosestHit(shaderWave);
+        } catch (...) {
+            escaped = std::current_exception();  // not one lane's: it stops every lane still running the shader
+        }
+    }
+    for (int i : lanes) {
+        LaneTrace& t = traces[size_t(i)];
+        endInvocation(*hits[size_t(i)].thread, callerSections[size_t(i)]);
+        if (shaderWave.failure(i)) *t.failure = shaderWave.failure(i);
+        else if (escaped && shaderWave.isActive(i)) *t.failure = escaped;
+        else t.end();
+    }
+}
 
 }  // namespace
 
 void traceRaysInWave(Wave& wave, const std::array<Invocation*, kMaxWaveWidth>& callers,
-                     const std::array<TraceRayCall, kMaxWaveWidth>& calls, LaneMask lanes,
+                     const TraceRayCall* calls, LaneMask lanes,
                      std::array<std::exception_ptr, kMaxWaveWidth>& failures) {
     std::array<LaneTrace, kMaxWaveWidth> traces;
     LaneMask packet, invoked;
@@ -167,24 +221,45 @@ void traceRaysInWave(Wave& wave, const std::array<Invocation*, kMaxWaveWidth>& c
             }
         }
     }
-    // The closest-hit shaders run on their lanes' fibers, which start in the caller's floating-point mode, since they
-    // may trace rays of their own (parked and traversed together as the lanes of any wave). A lane without one (a
-    // miss shader, or none: a miss, SKIP_CLOSEST_HIT_SHADER) finishes here, on the wave's stack: a TraceRay from its
-    // miss shader traverses at once (awaitTraversal).
+    // Each lane's closest-hit or miss shader, in the caller's floating-point mode:
+    // - a closest-hit shader written for waves runs once over the lanes that selected it (grouped by shader, each lane
+    //   with its own record), on the wave's stack: their TraceRays go out together, and their closest hits run as
+    //   waves in turn (runClosestHitWave);
+    // - any other closest-hit shader runs on its lane's fiber, since it may trace rays of its own (parked and
+    //   traversed together as the lanes of any wave);
+    // - a lane without one (a miss shader, or none: a miss, SKIP_CLOSEST_HIT_SHADER, a NULL record) finishes here, on
+    //   the wave's stack: a TraceRay from its miss shader traverses at once (awaitTraversal).
+    std::array<RecordView, kMaxWaveWidth> records;
+    std::array<Invocation, kMaxWaveWidth> hits;
+    RecordGroups waveHits;
     LaneMask onFibers;
     for (int i : invoked) {
         LaneTrace& t = traces[size_t(i)];
-        if (t.rs.committed && !(t.rs.effectiveFlags & RAY_FLAG_SKIP_CLOSEST_HIT_SHADER)) {
-            laneFiber(wave, i).start([&t] { t.finish(); });  // one pointer: no allocation
-            onFibers.set(i);
-        } else {
+        if (!t.rs.committed) {
             t.finish();
+            continue;
+        }
+        bool runs = false;
+        try {
+            runs = prepareClosestHit(*t.caller->thread, t.rs, siteOf(*t.caller), records[size_t(i)], hits[size_t(i)]);
+        } catch (...) {
+            failures[size_t(i)] = std::current_exception();
+            continue;
+        }
+        if (!runs) {
+            t.end();
+        } else if (hits[size_t(i)].shader->waveClosestHit) {
+            waveHits.add(i, hits[size_t(i)].shader, 0);
+        } else {
+            laneFiber(wave, i).start([&t, &hit = hits[size_t(i)]] { t.closestHit(hit); });  // two pointers
+            onFibers.set(i);
         }
     }
     if (onFibers.any()) {
         const MxcsrScope scheduling(wave.schedulerMxcsr);
         runLanes(wave, onFibers);
     }
+    for (const RecordGroups::Group& group : waveHits) runClosestHitWave(wave, *group.shader, group.lanes, traces, hits);
 }
 
 namespace {

@@ -80,6 +80,17 @@ uvec3 unpack3x16BitIndices(uint32_t offsetBytes, uvec2 four16BitIndices) {
     return result;
 }
 
+vec3 FirstVertexNormal(const dxr::ShaderContext& ctx, uint32_t vertexBuffersTable) {
+    const uint32_t indexSizeInBytes = 2;
+    const uint32_t indicesPerTriangle = 3;
+    const uint32_t triangleIndexStride = indicesPerTriangle * indexSizeInBytes;
+    const uint32_t baseIndex = ctx.PrimitiveIndex() * triangleIndexStride;
+    const dxr::GpuDescriptorHandle vertexBuffers = ctx.globalDescriptorTable(vertexBuffersTable);
+    const uvec3 indices = unpack3x16BitIndices(
+        baseIndex, ctx.loadFromTable<uvec2>(vertexBuffers, /*g_indices*/ 0, /*Load2 at*/ baseIndex & ~3u));
+    return ctx.loadFromTable<Vertex>(vertexBuffers, /*g_vertices*/ 1, uint64_t(indices[0]) * sizeof(Vertex)).normal;
+}
+
 uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t sizeInBytes) {
     const uint32_t dwordAlignedOffset = offsetBytes & ~3u;
     return unpack3x16BitIndices(offsetBytes, uvec2(loadDword(indices, sizeInBytes, dwordAlignedOffset),

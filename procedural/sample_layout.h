@@ -151,6 +151,11 @@ void CameraRaygen(dxr::RayGenerationWave& wave, uint32_t outputTable, Camera cam
 // The index triplet inside the 8 bytes a ByteAddressBuffer Load2 read at the dword-aligned
 // offset below `offsetBytes`.
 uvec3 unpack3x16BitIndices(uint32_t offsetBytes, uvec2 four16BitIndices);
+// Both samples' triangle closest hits' normal: the stored normal of the hit triangle's first vertex. The index
+// buffer is descriptor 0 (g_indices, t1) and the vertex buffer descriptor 1 (g_vertices, t2) of the global descriptor
+// table `vertexBuffersTable`; the indices are 16-bit, three per triangle, read as a ByteAddressBuffer Load2 at the
+// dword-aligned offset; reads past the end of a view give 0, as in D3D.
+vec3 FirstVertexNormal(const dxr::ShaderContext& ctx, uint32_t vertexBuffersTable);
 // Load3x16BitIndices: the three 16-bit indices at byte `offsetBytes`, read as two aligned
 // dwords the way a ByteAddressBuffer Load2 does. Dwords past `sizeInBytes` read 0.
 uvec3 Load3x16BitIndices(uint32_t offsetBytes, const uint8_t* indices, size_t sizeInBytes);

@@ -1,6 +1,7 @@
 // Record grouping (docs/emulator.md, "Waves"): the lanes of a packet that wait for an intersection shader, grouped
 // by the shader and the hit-group record that runs it, as a GPU gathers the threads that call the same shader with
-// the same record before running it once over them. Groups keep the order of their first lanes.
+// the same record before running it once over them. Groups keep the order of their first lanes. The lanes whose
+// closest-hit shader is written for waves are grouped by the shader alone (record 0: each lane keeps its own).
 #pragma once
 
 #include <array>

@@ -10,6 +10,8 @@
 
 namespace refray::dxr::detail {
 
+struct Site;
+
 // TraceRay (sections 4-10) from the shader `caller`: validation, candidate gathering, the TRV-4 loop, then the
 // closest-hit or miss shader. The payload is copied in and out (RAY-9).
 void traceRay(Invocation& caller, const TraceRayCall& call);
@@ -25,8 +27,13 @@ TraceRayStart beginTraceRay(Invocation& caller, const TraceRayCall& call, RaySta
                             std::optional<ValueCopy>& payload);
 // The closest-hit or miss shader (TRV-5, TRV-6), the TraceRayEnd event and the payload copied back.
 void finishTraceRay(Invocation& caller, const TraceRayCall& call, RayState& rs, ValueCopy& payload);
+// finishTraceRay for a closest hit that a wave runs (detail/wave.h): prepareClosestHit is TRV-5 up to the shader
+// call (FLAG-9, the hit group's record and its lookup rules, PIPE-6, PAY-1), true with `inv` (which points at
+// `record`) when a closest-hit shader runs; endTraceRay is what follows the shader (the TraceRayEnd event, the payload
+// copied back).
+bool prepareClosestHit(ThreadState& ts, RayState& rs, const Site& site, RecordView& record, Invocation& inv);
+void endTraceRay(Invocation& caller, const TraceRayCall& call, RayState& rs, ValueCopy& payload);
 
-struct Site;
 
 // The ray's validity (RAY-5, or `rule` for another caller such as RQ-11) and the RAY-7 warnings; sets `ok` false
 // after raising an error.

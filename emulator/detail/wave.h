@@ -82,7 +82,7 @@ void openWave(Wave& wave, size_t lanes);
 // traverse as one packet. Closest-hit shaders run on their lanes' fibers (their own TraceRays park as any lane's);
 // miss shaders on the wave's stack. What stops a lane's launch goes to failures[i].
 void traceRaysInWave(Wave& wave, const std::array<Invocation*, kMaxWaveWidth>& callers,
-                     const std::array<TraceRayCall, kMaxWaveWidth>& calls, LaneMask lanes,
+                     const TraceRayCall* calls, LaneMask lanes,
                      std::array<std::exception_ptr, kMaxWaveWidth>& failures);
 
 // TraceRay's traversal for `rs` (TRV-4: its candidates gathered, ordered and processed), which the caller's wave

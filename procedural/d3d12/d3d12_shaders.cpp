@@ -7,6 +7,7 @@
 #include <span>
 #include <type_traits>
 
+#include "emulator/closest_hit_wave.h"
 #include "emulator/intersection_wave.h"
 #include "emulator/ray_generation_wave.h"
 #include "emulator/shader_api.h"
@@ -450,30 +451,26 @@ bool RadianceRayCall(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, ui
     return true;
 }
 
+// PORT: TraceShadowRayAndReportIfHit up to its TraceRay: false where the HLSL returns false untraced (at
+// MAX_RAY_RECURSION_DEPTH, or with shadows switched off); else `shadowPayload` initialised and `call` the TraceRay
+// with it, for the caller to make (alone, or with a wave's other lanes). The function's result is then
+// shadowPayload.hit != 0.
 template <typename T>
-tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
-                          const tvec3<T>& origin, const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
-    return TracePayloadColor<T, RayPayload>(ctx, [&](RayPayload& rayPayload, TraceRayCall& call) {
-        return RadianceRayCall(ctx, traceRay, maxDepth, origin, direction, currentRayRecursionDepth, rayPayload, call);
-    });
-}
-
-template <typename T>
-bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
-                                  const Effects& effects, const tvec3<T>& origin, const tvec3<T>& direction,
-                                  uint32_t currentRayRecursionDepth) {
+bool ShadowRayCall(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth, const Effects& effects,
+                   const tvec3<T>& origin, const tvec3<T>& direction, uint32_t currentRayRecursionDepth,
+                   ShadowRayPayload& shadowPayload, TraceRayCall& call) {
     if (currentRayRecursionDepth >= maxDepth) return false;
     if (!kShadowMachinery || !effects.traceShadowRays) return false;  // PORT: shadows switched off (procedural/effects.h)
     // TMax 10000, not the distance to the light (I2).
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     // Starts as "hit": closest-hit and any-hit shaders are skipped, only MyMissShader_ShadowRay clears it.
-    ShadowRayPayload shadowPayload{1};
+    shadowPayload = ShadowRayPayload{1};
     const TraceRayArguments& shadow = traceRay[RayType::Shadow];
-    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[RayType::Shadow],
-                 shadow.instanceInclusionMask, /*HitGroup::Offset*/ shadow.rayContribution,
-                 /*HitGroup::GeometryStride*/ shadow.multiplier, /*MissShader::Offset*/ shadow.missShaderIndex, rayDesc,
-                 shadowPayload);
-    return shadowPayload.hit != 0;
+    call = traceRayCall(ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[RayType::Shadow],
+                        shadow.instanceInclusionMask, /*HitGroup::Offset*/ shadow.rayContribution,
+                        /*HitGroup::GeometryStride*/ shadow.multiplier, /*MissShader::Offset*/ shadow.missShaderIndex,
+                        rayDesc, shadowPayload);
+    return true;
 }
 
 // ---- Inline tracing (scenes/inline/InlineShadows.hlsl, InlineAmbientOcclusion.hlsl) -------------------
@@ -617,28 +614,106 @@ bool TraceShadowRayInlineAndReportIfHit(ShaderContext& ctx, const TraceRayArgume
 // How a closest hit traces its shadow ray: TraceRay (the sample) or a RayQuery (InlineShadows.hlsl).
 enum class ShadowTracing : uint8_t { TraceRay, Inline };
 
-// The shadow ray both closest hits start with: from HitWorldPosition() towards the light.
+// reflectanceCoef·(Fresnel, 1)·(reflection ray colour), for the reflection ray along reflect(D, normal) (D: the
+// incoming ray's WorldRayDirection()).
 template <typename T>
-bool TraceShadowRayTowardsLight(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
-                                const Effects& effects, const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth,
-                                ShadowTracing tracing, const Accuracy& accuracy, InlineVariant variant) {
-    const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
-    const tvec3<T> toLight = hlsl::normalize(tvec3<T>(vec3(g_sceneCB.lightPosition)) - hitPosition);
-    if (tracing == ShadowTracing::Inline)
-        return TraceShadowRayInlineAndReportIfHit(ctx, traceRay, maxDepth, effects, accuracy, hitPosition, toLight,
-                                                  recursionDepth, variant);
-    return TraceShadowRayAndReportIfHit(ctx, traceRay, maxDepth, effects, hitPosition, toLight, recursionDepth);
-}
-
-// reflectanceCoef·(Fresnel, 1)·(reflection ray colour), the reflection ray leaving HitWorldPosition().
-template <typename T>
-tvec4<T> ReflectedColor(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
-                        const tvec3<T>& normal, const PrimitiveConstantBuffer& l_materialCB, uint32_t recursionDepth) {
-    const tvec3<T> D = tvec3<T>(ctx.WorldRayDirection());
-    const tvec4<T> reflectionColor = TraceRadianceRay(ctx, traceRay, maxDepth, HitWorldPosition<T>(ctx),
-                                                      hlsl::reflect(D, normal), recursionDepth);
+tvec4<T> ReflectedColor(const tvec3<T>& D, const tvec3<T>& normal, const PrimitiveConstantBuffer& l_materialCB,
+                        const tvec4<T>& reflectionColor) {
     const tvec3<T> fresnelR = FresnelReflectanceSchlick(D, normal, tvec3<T>(vec3(l_materialCB.albedo)));
     return T(l_materialCB.reflectanceCoef) * tvec4<T>(fresnelR, T(1)) * reflectionColor;
+}
+
+// What a closest hit's lane carries from one TraceRay to the next: its constants, its normal, its shadow ray's
+// result and its reflection ray's payload.
+template <typename T>
+struct ClosestHitLane {
+    SceneConstantBuffer sceneCB;
+    PrimitiveConstantBuffer materialCB;
+    tvec3<T> normal;
+    T checkers = T(1);
+    ShadowRayPayload shadowPayload{};
+    bool shadowRayHit = false;
+    tvec3<T> D;
+    RayPayload reflectionPayload{};
+};
+
+// The code both closest hits share, over the lanes of a wave (emulator/closest_hit_wave.h), lane by lane the HLSL's:
+// `open(ctx, lane, attr)` reads a lane's constants and normal; its shadow ray from HitWorldPosition() towards the
+// light (TraceShadowRayAndReportIfHit, or traced inline); `beforeReflection(ctx, lane)` (the triangle's checkers);
+// its reflected component, reflectanceCoef > 0.001 (ReflectedColor: a reflection ray); its Phong colour, `combine(lane,
+// phongColor, reflectedColor)`, and the visibility falloff. The lanes' shadow rays go out together, then their
+// reflection rays.
+// PORT: the lanes' state is kept for N lanes: a wave's, or the one lane of a shader that runs alone.
+template <typename T, class Attributes, int N, class Open, class BeforeReflection, class Combine>
+void SampleClosestHitOver(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                          const Effects& effects, ShadowTracing tracing, InlineVariant variant, Open& open,
+                          BeforeReflection& beforeReflection, Combine& combine) {
+    [[maybe_unused]] PrecisionScope<T> scope;
+    const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
+    std::array<ClosestHitLane<T>, N> lanes;
+    std::array<TraceRayCall, N> calls;
+
+    // Shadow component.
+    LaneMask traced;
+    wave.forEachLane([&](int i, ShaderContext& ctx) {
+        ClosestHitLane<T>& l = lanes[size_t(i)];
+        const RayPayload& rayPayload = wave.payload<RayPayload>(i);
+        l.sceneCB = sceneCB(ctx);
+        l.materialCB = materialCB(ctx);
+        open(ctx, l, wave.attributes<Attributes>(i));
+        const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
+        const tvec3<T> toLight = hlsl::normalize(tvec3<T>(vec3(l.sceneCB.lightPosition)) - hitPosition);
+        if (tracing == ShadowTracing::Inline)
+            l.shadowRayHit = TraceShadowRayInlineAndReportIfHit(ctx, traceRay, maxDepth, effects, accuracy, hitPosition,
+                                                                toLight, rayPayload.recursionDepth, variant);
+        else if (ShadowRayCall(ctx, traceRay, maxDepth, effects, hitPosition, toLight, rayPayload.recursionDepth,
+                               l.shadowPayload, calls[size_t(i)]))
+            traced.set(i);
+    });
+    wave.TraceRay(traced, calls);
+    for (int i : traced) lanes[size_t(i)].shadowRayHit = lanes[size_t(i)].shadowPayload.hit != 0;
+
+    // Reflected component: the ray of ReflectedColor, when reflectanceCoef > 0.001.
+    traced = LaneMask();
+    wave.forEachLane([&](int i, ShaderContext& ctx) {
+        ClosestHitLane<T>& l = lanes[size_t(i)];
+        beforeReflection(ctx, l);
+        if (!(l.materialCB.reflectanceCoef > 0.001f)) return;
+        l.D = tvec3<T>(ctx.WorldRayDirection());
+        if (RadianceRayCall(ctx, traceRay, maxDepth, HitWorldPosition<T>(ctx), hlsl::reflect(l.D, l.normal),
+                            wave.payload<RayPayload>(i).recursionDepth, l.reflectionPayload, calls[size_t(i)]))
+            traced.set(i);
+    });
+    wave.TraceRay(traced, calls);
+
+    // Final colour, then the visibility falloff.
+    wave.forEachLane([&](int i, ShaderContext& ctx) {
+        const ClosestHitLane<T>& l = lanes[size_t(i)];
+        tvec4<T> reflectedColor(T(0));
+        if (l.materialCB.reflectanceCoef > 0.001f) {
+            // TraceRadianceRay's colour: black where RadianceRayCall made no ray (MAX_RAY_RECURSION_DEPTH).
+            const tvec4<T> reflectionColor = traced.test(i) ? tvec4<T>(l.reflectionPayload.color) : tvec4<T>(T(0));
+            reflectedColor = ReflectedColor(l.D, l.normal, l.materialCB, reflectionColor);
+        }
+        const tvec4<T> phongColor = CalculatePhongLighting(
+            l.sceneCB, tvec4<T>(l.materialCB.albedo), l.normal, l.shadowRayHit, T(l.materialCB.diffuseCoef),
+            T(l.materialCB.specularCoef), T(l.materialCB.specularPower), HitWorldPosition<T>(ctx),
+            tvec3<T>(ctx.WorldRayDirection()));
+        const tvec4<T> color = combine(l, phongColor, reflectedColor);
+        wave.payload<RayPayload>(i).color = vec4(ApplyVisibilityFalloff(color, T(ctx.RayTCurrent())));
+    });
+}
+
+template <typename T, class Attributes, class Open, class BeforeReflection, class Combine>
+void SampleClosestHit(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                      const Effects& effects, ShadowTracing tracing, InlineVariant variant, Open open,
+                      BeforeReflection beforeReflection, Combine combine) {
+    if (wave.runsAlone())
+        SampleClosestHitOver<T, Attributes, 1>(wave, traceRay, accuracy, effects, tracing, variant, open,
+                                               beforeReflection, combine);
+    else
+        SampleClosestHitOver<T, Attributes, kMaxWaveWidth>(wave, traceRay, accuracy, effects, tracing, variant, open,
+                                                           beforeReflection, combine);
 }
 
 // ---- Entry points ----------------------------------------------------------------------------------
@@ -663,76 +738,40 @@ void MyRaygenShader(RayGenerationWave& wave, const TraceRayArgumentSet& traceRay
         });
 }
 
+// PORT: written for waves (SampleClosestHit).
 template <typename T>
-void MyClosestHitShader_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                                 const Effects& effects, RayPayload& rayPayload, const BuiltInTriangleIntersectionAttributes&,
-                                 ShadowTracing tracing, InlineVariant variant) {
-    [[maybe_unused]] PrecisionScope<T> scope;
-    const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
-    const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
-
-    // The normal of the triangle's first vertex, untransformed.
-    const uint32_t indexSizeInBytes = 2;
-    const uint32_t indicesPerTriangle = 3;
-    const uint32_t triangleIndexStride = indicesPerTriangle * indexSizeInBytes;
-    const uint32_t baseIndex = ctx.PrimitiveIndex() * triangleIndexStride;
-    // g_indices is t1 (descriptor 0 of the table), g_vertices t2 (descriptor 1); out-of-range reads give 0.
-    const GpuDescriptorHandle vertexBuffers = ctx.globalDescriptorTable(kVertexBuffers);
-    const uvec3 indices = unpack3x16BitIndices(
-        baseIndex, ctx.loadFromTable<uvec2>(vertexBuffers, /*g_indices*/ 0, /*Load2 at*/ baseIndex & ~3u));
-    const tvec3<T> triangleNormal = tvec3<T>(
-        ctx.loadFromTable<Vertex>(vertexBuffers, /*g_vertices*/ 1, uint64_t(indices[0]) * sizeof(Vertex)).normal);
-
-    // Shadow component.
-    const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
-    const bool shadowRayHit =
-        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, effects, g_sceneCB, rayPayload.recursionDepth, tracing,
-                                      accuracy, variant);
-
-    // Grid lines from the primary camera rays' footprint, even for secondary hits (I7, H4).
-    const T checkers = AnalyticalCheckersTexture(
-        HitWorldPosition<T>(ctx), triangleNormal, tvec3<T>(vec3(g_sceneCB.cameraPosition)),
-        g_sceneCB.projectionToWorld, uvec2(ctx.DispatchRaysIndex()), uvec2(ctx.DispatchRaysDimensions()));
-
-    // Reflected component.
-    tvec4<T> reflectedColor(T(0));
-    if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor =
-            ReflectedColor(ctx, traceRay, maxDepth, triangleNormal, l_materialCB, rayPayload.recursionDepth);
-
-    // Final colour, then the visibility falloff.
-    const tvec4<T> phongColor = CalculatePhongLighting(
-        g_sceneCB, tvec4<T>(l_materialCB.albedo), triangleNormal, shadowRayHit, T(l_materialCB.diffuseCoef),
-        T(l_materialCB.specularCoef), T(l_materialCB.specularPower), HitWorldPosition<T>(ctx),
-        tvec3<T>(ctx.WorldRayDirection()));
-    const tvec4<T> color = checkers * (phongColor + reflectedColor);
-    rayPayload.color = vec4(ApplyVisibilityFalloff(color, T(ctx.RayTCurrent())));
+void MyClosestHitShader_Triangle(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                                 const Effects& effects, ShadowTracing tracing, InlineVariant variant) {
+    SampleClosestHit<T, BuiltInTriangleIntersectionAttributes>(
+        wave, traceRay, accuracy, effects, tracing, variant,
+        [](ShaderContext& ctx, ClosestHitLane<T>& l, const BuiltInTriangleIntersectionAttributes&) {
+            // The normal of the triangle's first vertex, untransformed.
+            l.normal = tvec3<T>(FirstVertexNormal(ctx, kVertexBuffers));
+        },
+        [](ShaderContext& ctx, ClosestHitLane<T>& l) {
+            // Grid lines from the primary camera rays' footprint, even for secondary hits (I7, H4).
+            l.checkers = AnalyticalCheckersTexture(
+                HitWorldPosition<T>(ctx), l.normal, tvec3<T>(vec3(l.sceneCB.cameraPosition)),
+                l.sceneCB.projectionToWorld, uvec2(ctx.DispatchRaysIndex()), uvec2(ctx.DispatchRaysDimensions()));
+        },
+        [](const ClosestHitLane<T>& l, const tvec4<T>& phongColor, const tvec4<T>& reflectedColor) {
+            return l.checkers * (phongColor + reflectedColor);
+        });
 }
 
+// PORT: written for waves (SampleClosestHit).
 template <typename T>
-void MyClosestHitShader_AABB(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                             const Effects& effects, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr,
-                             ShadowTracing tracing, InlineVariant variant) {
-    [[maybe_unused]] PrecisionScope<T> scope;
-    const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
-    const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
-    const tvec3<T> normal = tvec3<T>(attr.normal);
-
-    const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
-    const bool shadowRayHit =
-        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, effects, g_sceneCB, rayPayload.recursionDepth, tracing,
-                                      accuracy, variant);
-
-    tvec4<T> reflectedColor(T(0));
-    if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, traceRay, maxDepth, normal, l_materialCB, rayPayload.recursionDepth);
-
-    const tvec4<T> phongColor = CalculatePhongLighting(
-        g_sceneCB, tvec4<T>(l_materialCB.albedo), normal, shadowRayHit, T(l_materialCB.diffuseCoef),
-        T(l_materialCB.specularCoef), T(l_materialCB.specularPower), HitWorldPosition<T>(ctx),
-        tvec3<T>(ctx.WorldRayDirection()));
-    const tvec4<T> color = phongColor + reflectedColor;
-    rayPayload.color = vec4(ApplyVisibilityFalloff(color, T(ctx.RayTCurrent())));
+void MyClosestHitShader_AABB(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                             const Effects& effects, ShadowTracing tracing, InlineVariant variant) {
+    SampleClosestHit<T, ProceduralPrimitiveAttributes>(
+        wave, traceRay, accuracy, effects, tracing, variant,
+        [](ShaderContext&, ClosestHitLane<T>& l, const ProceduralPrimitiveAttributes& attr) {
+            l.normal = tvec3<T>(attr.normal);
+        },
+        [](ShaderContext&, ClosestHitLane<T>&) {},
+        [](const ClosestHitLane<T>&, const tvec4<T>& phongColor, const tvec4<T>& reflectedColor) {
+            return phongColor + reflectedColor;
+        });
 }
 
 void MyMissShader(ShaderContext&, RayPayload& rayPayload) { rayPayload.color = BackgroundColor; }
@@ -928,24 +967,35 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
     lib.addWaveRayGeneration("MyRaygenShader", in([traceRay, accuracy](RayGenerationWave& wave) {
                                  MyRaygenShader<T>(wave, traceRay, accuracy);
                              }));
-    // The sample's closest hits, and the inline-shadow variants of scenes/inline/InlineShadows.hlsl.
-    for (const ShadowTracing tracing : {ShadowTracing::TraceRay, ShadowTracing::Inline}) {
-        const std::string suffix = tracing == ShadowTracing::Inline ? "_InlineShadow" : "";
-        lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
+    // The sample's closest hits, as <name><suffix>, for one way of tracing their shadow rays (and one variant of the
+    // inline way). Traced with TraceRay they run as waves (addWaveClosestHit). Traced inline they run a lane at a
+    // time, on the lanes' fibers (ClosestHitWave::runAlone): there the intersection tests of their ray queries go out
+    // as wave calls over the wave's lanes (emulator/wave_call.h), which a wave of closest hits, on the wave's stack,
+    // would make one lane at a time.
+    const auto addClosestHits = [&](const std::string& suffix, ShadowTracing tracing, InlineVariant variant) {
+        const auto add = [&]<class Attributes>(const std::string& name, WaveClosestHitShader shader) {
+            if (tracing == ShadowTracing::TraceRay) {
+                lib.addWaveClosestHit<RayPayload, Attributes>(name, std::move(shader));
+                return;
+            }
+            lib.addClosestHit<RayPayload, Attributes>(
+                name, [shader](ShaderContext& ctx, RayPayload& payload, const Attributes& attr) {
+                    ClosestHitWave::runAlone(shader, ctx, &payload, &attr);
+                });
+        };
+        add.template operator()<BuiltInTriangleIntersectionAttributes>(
             "MyClosestHitShader_Triangle" + suffix,
-            in([traceRay, accuracy, effects, tracing](ShaderContext& ctx, RayPayload& payload,
-                                                      const BuiltInTriangleIntersectionAttributes& attr) {
-                MyClosestHitShader_Triangle<T>(ctx, traceRay, accuracy, effects, payload, attr, tracing,
-                                               InlineVariant::AsWritten);
+            in([traceRay, accuracy, effects, tracing, variant](ClosestHitWave& wave) {
+                MyClosestHitShader_Triangle<T>(wave, traceRay, accuracy, effects, tracing, variant);
             }));
-        lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
-            "MyClosestHitShader_AABB" + suffix,
-            in([traceRay, accuracy, effects, tracing](ShaderContext& ctx, RayPayload& payload,
-                                                      const ProceduralPrimitiveAttributes& attr) {
-                MyClosestHitShader_AABB<T>(ctx, traceRay, accuracy, effects, payload, attr, tracing,
-                                           InlineVariant::AsWritten);
+        add.template operator()<ProceduralPrimitiveAttributes>(
+            "MyClosestHitShader_AABB" + suffix, in([traceRay, accuracy, effects, tracing, variant](ClosestHitWave& wave) {
+                MyClosestHitShader_AABB<T>(wave, traceRay, accuracy, effects, tracing, variant);
             }));
-    }
+    };
+    // The sample's closest hits, and the inline-shadow variants of scenes/inline/InlineShadows.hlsl.
+    addClosestHits("", ShadowTracing::TraceRay, InlineVariant::AsWritten);
+    addClosestHits("_InlineShadow", ShadowTracing::Inline, InlineVariant::AsWritten);
     lib.declareRayQueries("MyClosestHitShader_Triangle_InlineShadow", {kInlineShadowQueryFlags});
     lib.declareRayQueries("MyClosestHitShader_AABB_InlineShadow", {kInlineShadowQueryFlags});
     lib.addCompute("InlineAmbientOcclusionCS", uvec3(8, 8, 1), in([traceRay, accuracy](ShaderContext& ctx) {
@@ -956,20 +1006,7 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
     for (const InlineVariant variant : kInlineVariants) {
         if (variant == InlineVariant::AsWritten) continue;
         const std::string suffix = "_InlineShadow" + inlineVariantSuffix(variant);
-        lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
-            "MyClosestHitShader_Triangle" + suffix,
-            in([traceRay, accuracy, effects, variant](ShaderContext& ctx, RayPayload& payload,
-                                                      const BuiltInTriangleIntersectionAttributes& attr) {
-                MyClosestHitShader_Triangle<T>(ctx, traceRay, accuracy, effects, payload, attr, ShadowTracing::Inline,
-                                               variant);
-            }));
-        lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
-            "MyClosestHitShader_AABB" + suffix,
-            in([traceRay, accuracy, effects, variant](ShaderContext& ctx, RayPayload& payload,
-                                                      const ProceduralPrimitiveAttributes& attr) {
-                MyClosestHitShader_AABB<T>(ctx, traceRay, accuracy, effects, payload, attr, ShadowTracing::Inline,
-                                           variant);
-            }));
+        addClosestHits(suffix, ShadowTracing::Inline, variant);
         lib.declareRayQueries("MyClosestHitShader_Triangle" + suffix, {inlineShadowQueryFlags(variant)});
         lib.declareRayQueries("MyClosestHitShader_AABB" + suffix, {inlineShadowQueryFlags(variant)});
         const std::string cs = "InlineAmbientOcclusionCS" + inlineVariantSuffix(variant);

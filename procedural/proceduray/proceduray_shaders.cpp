@@ -393,18 +393,9 @@ void ClosestHit_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay
     }
     const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
 
-    // The triangle's first 16-bit index, and the negated stored normal of that vertex.
-    const uint32_t indexSizeInBytes = 2;
-    const uint32_t indicesPerTriangle = 3;
-    const uint32_t triangleIndexStride = indicesPerTriangle * indexSizeInBytes;
-    const uint32_t baseIndex = ctx.PrimitiveIndex() * triangleIndexStride;
-    // g_indices is t1 (descriptor 0 of the table at global parameter 4), g_vertices t2 (descriptor 1); reads past
-    // the end of a view give 0, as in D3D.
-    const GpuDescriptorHandle vertexBuffers = ctx.globalDescriptorTable(kVertexBuffers);
-    const uvec3 indices = unpack3x16BitIndices(
-        baseIndex, ctx.loadFromTable<uvec2>(vertexBuffers, /*g_indices*/ 0, /*Load2 at*/ baseIndex & ~3u));
-    const vec3 storedNormal =
-        ctx.loadFromTable<Vertex>(vertexBuffers, /*g_vertices*/ 1, uint64_t(indices[0]) * sizeof(Vertex)).normal;
+    // The negated stored normal of the triangle's first vertex (g_indices is t1, g_vertices t2 of the table at
+    // global parameter 4).
+    const vec3 storedNormal = FirstVertexNormal(ctx, kVertexBuffers);
     const tvec3<T> triangleNormal = -tvec3<T>(storedNormal);
 
     const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
