@@ -54,19 +54,34 @@ public:
     // when this returns). Lanes outside `lanes` trace nothing; `calls` reaches at least the highest lane of `lanes`.
     void TraceRay(LaneMask lanes, std::span<const TraceRayCall> calls);
 
+    // The shape of a shader whose code runs in steps with TraceRays between them, over the wave: every active lane
+    // runs the first step, `step(lane, ctx, state, call)`, which returns whether the lane traces a ray before the
+    // next step (`call` its TraceRay, whose payload the lane's `state` may hold); the lanes' rays go out together;
+    // then every active lane runs the next step, and so on (the last step's result is ignored). `state` is the lane's
+    // own State, value-initialised, kept from step to step. A shader that runs alone keeps lane 0's only.
+    template <class State, class... Steps>
+    void TraceRaysInSteps(Steps&&... steps) {
+        if (runsAlone()) inSteps<State, 1>(steps...);
+        else inSteps<State, kMaxWaveWidth>(steps...);
+    }
+
     // The shape of a shader with one TraceRay a launch, over the wave: each active lane runs its code up to the
     // TraceRay (`before(ctx, payload, call)`: whether the lane traces, with its payload set and its call built),
     // the lanes' TraceRays run together, then each lane runs its code after it (`after(ctx, payload, traced)`).
     template <class Payload, class Before, class After>
     void TraceRayInEachLane(Before&& before, After&& after) {
-        std::array<Payload, kMaxWaveWidth> payloads{};
-        std::array<TraceRayCall, kMaxWaveWidth> calls{};
-        LaneMask tracing;
-        forEachLane([&](int i, ShaderContext& ctx) {
-            if (before(ctx, payloads[size_t(i)], calls[size_t(i)])) tracing.set(i);
-        });
-        TraceRay(tracing, calls);
-        forEachLane([&](int i, ShaderContext& ctx) { after(ctx, std::as_const(payloads[size_t(i)]), tracing.test(i)); });
+        struct Lane {
+            Payload payload;
+            bool traced;
+        };
+        TraceRaysInSteps<Lane>(
+            [&](int, ShaderContext& ctx, Lane& l, TraceRayCall& call) {
+                return l.traced = before(ctx, l.payload, call);
+            },
+            [&](int, ShaderContext& ctx, Lane& l, TraceRayCall&) {
+                after(ctx, std::as_const(l.payload), l.traced);
+                return false;
+            });
     }
 
     // Whether the shader runs for one lane alone (lane 0; its export's ShaderExport::function, at a wave width of 1,
@@ -85,6 +100,22 @@ protected:
 
 private:
     void fail(int lane, std::exception_ptr failure);
+
+    // TraceRaysInSteps with the state of N lanes (a wave's, or lane 0's alone).
+    template <class State, int N, class... Steps>
+    void inSteps(Steps&... steps) {
+        std::array<State, N> states{};
+        std::array<TraceRayCall, N> calls;
+        size_t stepsRun = 0;
+        const auto run = [&](auto& step) {
+            LaneMask tracing;
+            forEachLane([&](int i, ShaderContext& ctx) {
+                if (step(i, ctx, states[size_t(i)], calls[size_t(i)])) tracing.set(i);
+            });
+            if (++stepsRun < sizeof...(Steps)) TraceRay(tracing, calls);
+        };
+        (run(steps), ...);
+    }
 
     std::array<ShaderContext*, kMaxWaveWidth> contexts_;
     LaneMask active_;

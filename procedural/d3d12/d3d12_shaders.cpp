@@ -624,96 +624,75 @@ tvec4<T> ReflectedColor(const tvec3<T>& D, const tvec3<T>& normal, const Primiti
 }
 
 // What a closest hit's lane carries from one TraceRay to the next: its constants, its normal, its shadow ray's
-// result and its reflection ray's payload.
+// payload and result, and its reflection ray's.
 template <typename T>
 struct ClosestHitLane {
     SceneConstantBuffer sceneCB;
     PrimitiveConstantBuffer materialCB;
     tvec3<T> normal;
     T checkers = T(1);
-    ShadowRayPayload shadowPayload{};
+    ShadowRayPayload shadowPayload;
+    bool shadowTraced = false;
     bool shadowRayHit = false;
     tvec3<T> D;
-    RayPayload reflectionPayload{};
+    RayPayload reflectionPayload;
+    bool reflected = false;
 };
 
 // The code both closest hits share, over the lanes of a wave (emulator/closest_hit_wave.h), lane by lane the HLSL's:
-// `open(ctx, lane, attr)` reads a lane's constants and normal; its shadow ray from HitWorldPosition() towards the
-// light (TraceShadowRayAndReportIfHit, or traced inline); `beforeReflection(ctx, lane)` (the triangle's checkers);
-// its reflected component, reflectanceCoef > 0.001 (ReflectedColor: a reflection ray); its Phong colour, `combine(lane,
+// `open(ctx, lane, attr)` reads a lane's normal; its shadow ray from HitWorldPosition() towards the light
+// (TraceShadowRayAndReportIfHit, or traced inline); `beforeReflection(ctx, lane)` (the triangle's checkers); its
+// reflected component, reflectanceCoef > 0.001 (ReflectedColor: a reflection ray); its Phong colour, `combine(lane,
 // phongColor, reflectedColor)`, and the visibility falloff. The lanes' shadow rays go out together, then their
-// reflection rays.
-// PORT: the lanes' state is kept for N lanes: a wave's, or the one lane of a shader that runs alone.
-template <typename T, class Attributes, int N, class Open, class BeforeReflection, class Combine>
-void SampleClosestHitOver(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                          const Effects& effects, ShadowTracing tracing, InlineVariant variant, Open& open,
-                          BeforeReflection& beforeReflection, Combine& combine) {
-    [[maybe_unused]] PrecisionScope<T> scope;
-    const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
-    std::array<ClosestHitLane<T>, N> lanes;
-    std::array<TraceRayCall, N> calls;
-
-    // Shadow component.
-    LaneMask traced;
-    wave.forEachLane([&](int i, ShaderContext& ctx) {
-        ClosestHitLane<T>& l = lanes[size_t(i)];
-        const RayPayload& rayPayload = wave.payload<RayPayload>(i);
-        l.sceneCB = sceneCB(ctx);
-        l.materialCB = materialCB(ctx);
-        open(ctx, l, wave.attributes<Attributes>(i));
-        const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
-        const tvec3<T> toLight = hlsl::normalize(tvec3<T>(vec3(l.sceneCB.lightPosition)) - hitPosition);
-        if (tracing == ShadowTracing::Inline)
-            l.shadowRayHit = TraceShadowRayInlineAndReportIfHit(ctx, traceRay, maxDepth, effects, accuracy, hitPosition,
-                                                                toLight, rayPayload.recursionDepth, variant);
-        else if (ShadowRayCall(ctx, traceRay, maxDepth, effects, hitPosition, toLight, rayPayload.recursionDepth,
-                               l.shadowPayload, calls[size_t(i)]))
-            traced.set(i);
-    });
-    wave.TraceRay(traced, calls);
-    for (int i : traced) lanes[size_t(i)].shadowRayHit = lanes[size_t(i)].shadowPayload.hit != 0;
-
-    // Reflected component: the ray of ReflectedColor, when reflectanceCoef > 0.001.
-    traced = LaneMask();
-    wave.forEachLane([&](int i, ShaderContext& ctx) {
-        ClosestHitLane<T>& l = lanes[size_t(i)];
-        beforeReflection(ctx, l);
-        if (!(l.materialCB.reflectanceCoef > 0.001f)) return;
-        l.D = tvec3<T>(ctx.WorldRayDirection());
-        if (RadianceRayCall(ctx, traceRay, maxDepth, HitWorldPosition<T>(ctx), hlsl::reflect(l.D, l.normal),
-                            wave.payload<RayPayload>(i).recursionDepth, l.reflectionPayload, calls[size_t(i)]))
-            traced.set(i);
-    });
-    wave.TraceRay(traced, calls);
-
-    // Final colour, then the visibility falloff.
-    wave.forEachLane([&](int i, ShaderContext& ctx) {
-        const ClosestHitLane<T>& l = lanes[size_t(i)];
-        tvec4<T> reflectedColor(T(0));
-        if (l.materialCB.reflectanceCoef > 0.001f) {
-            // TraceRadianceRay's colour: black where RadianceRayCall made no ray (MAX_RAY_RECURSION_DEPTH).
-            const tvec4<T> reflectionColor = traced.test(i) ? tvec4<T>(l.reflectionPayload.color) : tvec4<T>(T(0));
-            reflectedColor = ReflectedColor(l.D, l.normal, l.materialCB, reflectionColor);
-        }
-        const tvec4<T> phongColor = CalculatePhongLighting(
-            l.sceneCB, tvec4<T>(l.materialCB.albedo), l.normal, l.shadowRayHit, T(l.materialCB.diffuseCoef),
-            T(l.materialCB.specularCoef), T(l.materialCB.specularPower), HitWorldPosition<T>(ctx),
-            tvec3<T>(ctx.WorldRayDirection()));
-        const tvec4<T> color = combine(l, phongColor, reflectedColor);
-        wave.payload<RayPayload>(i).color = vec4(ApplyVisibilityFalloff(color, T(ctx.RayTCurrent())));
-    });
-}
-
+// reflection rays (TracingWave::TraceRaysInSteps).
 template <typename T, class Attributes, class Open, class BeforeReflection, class Combine>
 void SampleClosestHit(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
                       const Effects& effects, ShadowTracing tracing, InlineVariant variant, Open open,
                       BeforeReflection beforeReflection, Combine combine) {
-    if (wave.runsAlone())
-        SampleClosestHitOver<T, Attributes, 1>(wave, traceRay, accuracy, effects, tracing, variant, open,
-                                               beforeReflection, combine);
-    else
-        SampleClosestHitOver<T, Attributes, kMaxWaveWidth>(wave, traceRay, accuracy, effects, tracing, variant, open,
-                                                           beforeReflection, combine);
+    [[maybe_unused]] PrecisionScope<T> scope;
+    const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
+    wave.TraceRaysInSteps<ClosestHitLane<T>>(
+        // Shadow component.
+        [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall& call) {
+            const uint32_t recursionDepth = wave.payload<RayPayload>(i).recursionDepth;
+            l.sceneCB = sceneCB(ctx);
+            l.materialCB = materialCB(ctx);
+            open(ctx, l, wave.attributes<Attributes>(i));
+            const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
+            const tvec3<T> toLight = hlsl::normalize(tvec3<T>(vec3(l.sceneCB.lightPosition)) - hitPosition);
+            if (tracing == ShadowTracing::TraceRay)
+                return l.shadowTraced = ShadowRayCall(ctx, traceRay, maxDepth, effects, hitPosition, toLight,
+                                                      recursionDepth, l.shadowPayload, call);
+            l.shadowRayHit = TraceShadowRayInlineAndReportIfHit(ctx, traceRay, maxDepth, effects, accuracy, hitPosition,
+                                                                toLight, recursionDepth, variant);
+            return false;
+        },
+        // Reflected component: the ray of ReflectedColor, when reflectanceCoef > 0.001.
+        [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall& call) {
+            if (l.shadowTraced) l.shadowRayHit = l.shadowPayload.hit != 0;  // TraceShadowRayAndReportIfHit's result
+            beforeReflection(ctx, l);
+            if (!(l.materialCB.reflectanceCoef > 0.001f)) return false;
+            l.D = tvec3<T>(ctx.WorldRayDirection());
+            return l.reflected = RadianceRayCall(ctx, traceRay, maxDepth, HitWorldPosition<T>(ctx),
+                                                 hlsl::reflect(l.D, l.normal), wave.payload<RayPayload>(i).recursionDepth,
+                                                 l.reflectionPayload, call);
+        },
+        // Final colour, then the visibility falloff.
+        [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall&) {
+            tvec4<T> reflectedColor(T(0));
+            if (l.materialCB.reflectanceCoef > 0.001f) {
+                // TraceRadianceRay's colour: black where RadianceRayCall made no ray (MAX_RAY_RECURSION_DEPTH).
+                const tvec4<T> reflectionColor = l.reflected ? tvec4<T>(l.reflectionPayload.color) : tvec4<T>(T(0));
+                reflectedColor = ReflectedColor(l.D, l.normal, l.materialCB, reflectionColor);
+            }
+            const tvec4<T> phongColor = CalculatePhongLighting(
+                l.sceneCB, tvec4<T>(l.materialCB.albedo), l.normal, l.shadowRayHit, T(l.materialCB.diffuseCoef),
+                T(l.materialCB.specularCoef), T(l.materialCB.specularPower), HitWorldPosition<T>(ctx),
+                tvec3<T>(ctx.WorldRayDirection()));
+            const tvec4<T> color = combine(l, phongColor, reflectedColor);
+            wave.payload<RayPayload>(i).color = vec4(ApplyVisibilityFalloff(color, T(ctx.RayTCurrent())));
+            return false;
+        });
 }
 
 // ---- Entry points ----------------------------------------------------------------------------------

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstring>
 
+#include "emulator/closest_hit_wave.h"
 #include "emulator/intersection_wave.h"
 #include "emulator/ray_generation_wave.h"
 #include "emulator/shader_api.h"
@@ -290,50 +291,94 @@ bool RadianceRayCall(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, ui
     return true;
 }
 
+// PORT: TraceShadowRayAndReportIfHit towards the light from HitWorldPosition(), up to its TraceRay: false where the
+// HLSL returns false untraced (at MAX_RAY_RECURSION_DEPTH, or with shadows switched off); else `shadowPayload`
+// initialised and `call` the TraceRay with it, for the caller to make (alone, or with a wave's other lanes). The
+// function's result is then shadowPayload.hit != 0.
 template <typename T>
-tvec4<T> TraceRadianceRay(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
-                          const tvec3<T>& origin, const tvec3<T>& direction, uint32_t currentRayRecursionDepth) {
-    return TracePayloadColor<T, RayPayload>(ctx, [&](RayPayload& rayPayload, TraceRayCall& call) {
-        return RadianceRayCall(ctx, traceRay, maxDepth, origin, direction, currentRayRecursionDepth, rayPayload, call);
-    });
-}
-
-template <typename T>
-bool TraceShadowRayAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
-                                  const Effects& effects, const tvec3<T>& origin, const tvec3<T>& direction,
-                                  uint32_t currentRayRecursionDepth) {
+bool ShadowRayTowardsLightCall(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
+                               const Effects& effects, const SceneConstantBuffer& g_sceneCB,
+                               uint32_t currentRayRecursionDepth, ShadowRayPayload& shadowPayload, TraceRayCall& call) {
+    const tvec3<T> origin = HitWorldPosition<T>(ctx);
+    const tvec3<T> direction = hlsl::normalize(tvec3<T>(g_sceneCB.lightPosition) - origin);
     if (currentRayRecursionDepth >= maxDepth) return false;
     if (!kShadowMachinery || !effects.traceShadowRays) return false;  // PORT: shadows switched off (procedural/effects.h)
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     // Starts as "hit": closest-hit and any-hit shaders are skipped, only Miss_Shadow clears it.
-    ShadowRayPayload shadowPayload{0.0f, 1};
+    shadowPayload = ShadowRayPayload{0.0f, 1};
     const TraceRayArguments& shadow = traceRay[Shadow];
-    ctx.TraceRay(ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[Shadow],
-                 shadow.instanceInclusionMask, /*RayContributionToHitGroupIndex*/ shadow.rayContribution,
-                 /*MultiplierForGeometryContribution*/ shadow.multiplier, /*MissShaderIndex*/ shadow.missShaderIndex,
-                 rayDesc, shadowPayload);
-    return shadowPayload.hit != 0;
+    call = traceRayCall(ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[Shadow],
+                        shadow.instanceInclusionMask, /*RayContributionToHitGroupIndex*/ shadow.rayContribution,
+                        /*MultiplierForGeometryContribution*/ shadow.multiplier,
+                        /*MissShaderIndex*/ shadow.missShaderIndex, rayDesc, shadowPayload);
+    return true;
 }
 
-// The shadow test every lit closest hit starts with: from HitWorldPosition() towards the light.
+// reflectanceCoef·(Fresnel, 1)·(reflection ray colour), for the reflection ray along reflect(D, normal) (D: the
+// incoming ray's WorldRayDirection()).
 template <typename T>
-bool TraceShadowRayTowardsLight(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
-                                const Effects& effects, const SceneConstantBuffer& g_sceneCB, uint32_t recursionDepth) {
-    const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
-    return TraceShadowRayAndReportIfHit(ctx, traceRay, maxDepth, effects, hitPosition,
-                                        hlsl::normalize(tvec3<T>(g_sceneCB.lightPosition) - hitPosition),
-                                        recursionDepth);
-}
-
-// reflectanceCoef·(Fresnel, 1)·(reflection ray colour), the reflection ray leaving HitWorldPosition().
-template <typename T>
-tvec4<T> ReflectedColor(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
-                        const tvec3<T>& normal, T reflectanceCoef, const tvec3<T>& f0, uint32_t recursionDepth) {
-    const tvec3<T> D = tvec3<T>(ctx.WorldRayDirection());
-    const tvec4<T> reflectionColor = TraceRadianceRay(ctx, traceRay, maxDepth, HitWorldPosition<T>(ctx),
-                                                      hlsl::reflect(D, normal), recursionDepth);
+tvec4<T> ReflectedColor(const tvec3<T>& D, const tvec3<T>& normal, T reflectanceCoef, const tvec3<T>& f0,
+                        const tvec4<T>& reflectionColor) {
     const tvec3<T> fresnelR = FresnelReflectanceSchlick(D, normal, f0);
     return reflectanceCoef * tvec4<T>(fresnelR, T(1)) * reflectionColor;
+}
+
+// What a closest hit's lane carries from one TraceRay to the next.
+template <typename T>
+struct ClosestHitLane {
+    bool returned = false;  // the shader returned early (a debug colour)
+    SceneConstantBuffer sceneCB;
+    PrimitiveConstantBuffer materialCB;
+    tvec3<T> normal;
+    tvec4<T> albedo;
+    tvec4<T> color;  // what the shader computed before its reflection (the Mandelbulb's surface colour)
+    ShadowRayPayload shadowPayload;
+    bool shadowTraced = false;
+    bool shadowRayHit = false;
+    bool reflects = false;  // reflectanceCoef > 0.001
+    T reflectanceCoef;
+    tvec3<T> f0;  // the Fresnel term's
+    tvec3<T> D;
+    RayPayload reflectionPayload;
+    bool reflected = false;
+};
+
+// The shape of the closest hits, over the lanes of a wave (emulator/closest_hit_wave.h), lane by lane the HLSL's:
+// `open(ctx, lane, payload, attr)` runs a lane's code up to its shadow ray (false: the shader returns there), then,
+// where `shadows` is set, its shadow ray towards the light (TraceShadowRayTowardsLight); its reflection ray when
+// lane.reflects (ReflectedColor); `close(ctx, lane, payload, attr, reflectedColor)` the rest. The lanes' shadow rays
+// go out together, then their reflection rays (TracingWave::TraceRaysInSteps).
+template <typename T, class Attributes, class Open, class Close>
+void LitClosestHit(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay, uint32_t maxDepth, const Effects& effects,
+                   bool shadows, Open open, Close close) {
+    [[maybe_unused]] PrecisionScope<T> scope;
+    wave.TraceRaysInSteps<ClosestHitLane<T>>(
+        [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall& call) {
+            RayPayload& rayPayload = wave.payload<RayPayload>(i);
+            l.returned = !open(ctx, l, rayPayload, wave.attributes<Attributes>(i));
+            if (l.returned || !shadows) return false;
+            return l.shadowTraced = ShadowRayTowardsLightCall<T>(ctx, traceRay, maxDepth, effects, l.sceneCB,
+                                                                 rayPayload.recursionDepth, l.shadowPayload, call);
+        },
+        [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall& call) {
+            if (l.shadowTraced) l.shadowRayHit = l.shadowPayload.hit != 0;  // TraceShadowRayAndReportIfHit's result
+            if (l.returned || !l.reflects) return false;
+            l.D = tvec3<T>(ctx.WorldRayDirection());
+            return l.reflected = RadianceRayCall(ctx, traceRay, maxDepth, HitWorldPosition<T>(ctx),
+                                                 hlsl::reflect(l.D, l.normal), wave.payload<RayPayload>(i).recursionDepth,
+                                                 l.reflectionPayload, call);
+        },
+        [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall&) {
+            if (l.returned) return false;
+            tvec4<T> reflectedColor(T(0));
+            if (l.reflects) {
+                // TraceRadianceRay's colour: black where RadianceRayCall made no ray (MAX_RAY_RECURSION_DEPTH).
+                const tvec4<T> reflectionColor = l.reflected ? tvec4<T>(l.reflectionPayload.color) : tvec4<T>(T(0));
+                reflectedColor = ReflectedColor(l.D, l.normal, l.reflectanceCoef, l.f0, reflectionColor);
+            }
+            close(ctx, l, wave.payload<RayPayload>(i), wave.attributes<Attributes>(i), reflectedColor);
+            return false;
+        });
 }
 
 // ProceduralPrimitivesLibrary.hlsli GetDistanceFromSignedDistancePrimitive: only the Pac-man case is live.
@@ -382,39 +427,41 @@ void Miss_Shadow(ShaderContext&, ShadowRayPayload& rayPayload) {
     rayPayload.hit = 0;
 }
 
+// PORT: written for waves (LitClosestHit).
 template <typename T>
-void ClosestHit_Triangle(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                         const Effects& effects, RayPayload& rayPayload, const BuiltInTriangleIntersectionAttributes&) {
-    [[maybe_unused]] PrecisionScope<T> scope;
-    const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
-    if (g_sceneCB.debugFlag) {
-        rayPayload.color = vec4(0.0f, 0.0f, 1.0f, 0.0f);
-        return;
-    }
-    const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
-
-    // The negated stored normal of the triangle's first vertex (g_indices is t1, g_vertices t2 of the table at
-    // global parameter 4).
-    const vec3 storedNormal = FirstVertexNormal(ctx, kVertexBuffers);
-    const tvec3<T> triangleNormal = -tvec3<T>(storedNormal);
-
+void ClosestHit_Triangle(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                         const Effects& effects) {
     const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
-    const bool shadowRayHit =
-        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, effects, g_sceneCB, rayPayload.recursionDepth);
-
-    const tvec4<T> albedo = tvec4<T>(l_materialCB.albedo);
-    tvec4<T> reflectedColor(T(0));
-    if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, traceRay, maxDepth, triangleNormal, T(l_materialCB.reflectanceCoef),
-                                        tvec3<T>(albedo), rayPayload.recursionDepth);
-
-    const tvec4<T> phongColor = CalculatePhongLighting(
-        g_sceneCB, albedo, triangleNormal, shadowRayHit, T(l_materialCB.diffuseCoef), T(l_materialCB.specularCoef),
-        T(l_materialCB.specularPower), HitWorldPosition<T>(ctx), tvec3<T>(ctx.WorldRayDirection()));
-    tvec4<T> color = phongColor + reflectedColor;
-    color += tvec4<T>(rayPayload.color);
-    rayPayload.dist += ctx.RayTCurrent();
-    rayPayload.color = vec4(color);
+    LitClosestHit<T, BuiltInTriangleIntersectionAttributes>(
+        wave, traceRay, maxDepth, effects, /*shadows*/ true,
+        [](ShaderContext& ctx, ClosestHitLane<T>& l, RayPayload& rayPayload, const BuiltInTriangleIntersectionAttributes&) {
+            l.sceneCB = sceneCB(ctx);
+            if (l.sceneCB.debugFlag) {
+                rayPayload.color = vec4(0.0f, 0.0f, 1.0f, 0.0f);
+                return false;
+            }
+            l.materialCB = materialCB(ctx);
+            // The negated stored normal of the triangle's first vertex (g_indices is t1, g_vertices t2 of the table
+            // at global parameter 4).
+            const vec3 storedNormal = FirstVertexNormal(ctx, kVertexBuffers);
+            l.normal = -tvec3<T>(storedNormal);
+            l.albedo = tvec4<T>(l.materialCB.albedo);
+            l.reflects = l.materialCB.reflectanceCoef > 0.001f;
+            l.reflectanceCoef = T(l.materialCB.reflectanceCoef);
+            l.f0 = tvec3<T>(l.albedo);
+            return true;
+        },
+        [](ShaderContext& ctx, const ClosestHitLane<T>& l, RayPayload& rayPayload,
+           const BuiltInTriangleIntersectionAttributes&, const tvec4<T>& reflectedColor) {
+            const tvec4<T> phongColor = CalculatePhongLighting(
+                l.sceneCB, l.albedo, l.normal, l.shadowRayHit, T(l.materialCB.diffuseCoef),
+                T(l.materialCB.specularCoef), T(l.materialCB.specularPower), HitWorldPosition<T>(ctx),
+                tvec3<T>(ctx.WorldRayDirection()));
+            tvec4<T> color = phongColor + reflectedColor;
+            color += tvec4<T>(rayPayload.color);
+            rayPayload.dist += ctx.RayTCurrent();
+            rayPayload.color = vec4(color);
+        });
 }
 
 // ---- The intersection shaders, run over the lanes of a record group (emulator/intersection_wave.h) ----------------
@@ -536,35 +583,38 @@ void Intersection_Pacman(IntersectionWave& wave, const Accuracy& accuracy) {
     });
 }
 
+// PORT: written for waves (LitClosestHit).
 template <typename T>
-void ClosestHit_Pacman(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                       const Effects& effects, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
-    [[maybe_unused]] PrecisionScope<T> scope;
-    if (ctx.HitKind() == 1) {
-        rayPayload.color = vec4(0.0f, 0.0f, 1.0f, 0.0f);
-        return;
-    }
-    const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
-    const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
-    const tvec3<T> normal = tvec3<T>(attr.normal);
-    const tvec4<T> albedo = tvec4<T>(l_materialCB.albedo);
-
+void ClosestHit_Pacman(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                       const Effects& effects) {
     const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
-    const bool shadowRayHit =
-        TraceShadowRayTowardsLight<T>(ctx, traceRay, maxDepth, effects, g_sceneCB, rayPayload.recursionDepth);
-
-    tvec4<T> reflectedColor(T(0));
-    if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor = ReflectedColor(ctx, traceRay, maxDepth, normal, T(l_materialCB.reflectanceCoef),
-                                        tvec3<T>(albedo), rayPayload.recursionDepth);
-
-    const tvec4<T> phongColor = CalculatePhongLighting(
-        g_sceneCB, albedo, normal, shadowRayHit, T(l_materialCB.diffuseCoef), T(l_materialCB.specularCoef),
-        T(l_materialCB.specularPower), HitWorldPosition<T>(ctx), tvec3<T>(ctx.WorldRayDirection()));
-    tvec4<T> color = tvec4<T>(attr.color) * (phongColor + reflectedColor);
-    color += tvec4<T>(rayPayload.color);
-    rayPayload.dist += ctx.RayTCurrent();
-    rayPayload.color = vec4(color);
+    LitClosestHit<T, ProceduralPrimitiveAttributes>(
+        wave, traceRay, maxDepth, effects, /*shadows*/ true,
+        [](ShaderContext& ctx, ClosestHitLane<T>& l, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
+            if (ctx.HitKind() == 1) {
+                rayPayload.color = vec4(0.0f, 0.0f, 1.0f, 0.0f);
+                return false;
+            }
+            l.sceneCB = sceneCB(ctx);
+            l.materialCB = materialCB(ctx);
+            l.normal = tvec3<T>(attr.normal);
+            l.albedo = tvec4<T>(l.materialCB.albedo);
+            l.reflects = l.materialCB.reflectanceCoef > 0.001f;
+            l.reflectanceCoef = T(l.materialCB.reflectanceCoef);
+            l.f0 = tvec3<T>(l.albedo);
+            return true;
+        },
+        [](ShaderContext& ctx, const ClosestHitLane<T>& l, RayPayload& rayPayload,
+           const ProceduralPrimitiveAttributes& attr, const tvec4<T>& reflectedColor) {
+            const tvec4<T> phongColor = CalculatePhongLighting(
+                l.sceneCB, l.albedo, l.normal, l.shadowRayHit, T(l.materialCB.diffuseCoef),
+                T(l.materialCB.specularCoef), T(l.materialCB.specularPower), HitWorldPosition<T>(ctx),
+                tvec3<T>(ctx.WorldRayDirection()));
+            tvec4<T> color = tvec4<T>(attr.color) * (phongColor + reflectedColor);
+            color += tvec4<T>(rayPayload.color);
+            rayPayload.dist += ctx.RayTCurrent();
+            rayPayload.color = vec4(color);
+        });
 }
 
 template <typename T, typename L>
@@ -609,29 +659,32 @@ void Intersection_Mandelbulb(IntersectionWave& wave, const Accuracy& accuracy) {
     });
 }
 
+// PORT: written for waves (LitClosestHit; no shadow ray).
 template <typename T>
-void ClosestHit_Mandelbulb(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                           RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
-    [[maybe_unused]] PrecisionScope<T> scope;
-    if (ctx.HitKind() == 1) {
-        rayPayload.color = vec4(0.0f, 1.0f, 0.0f, 0.0f);
-        return;
-    }
-    const PrimitiveConstantBuffer l_materialCB = materialCB(ctx);
-    const tvec3<T> normal = tvec3<T>(attr.normal);
-
-    tvec4<T> color = MandelbulbSurfaceColor(tvec3<T>(ctx.WorldRayDirection()), normal, tvec4<T>(attr.color));
-
-    tvec4<T> reflectedColor(T(0));
-    if (l_materialCB.reflectanceCoef > 0.001f)
-        reflectedColor =
-            ReflectedColor(ctx, traceRay, maxRayRecursionDepth(accuracy), normal, T(l_materialCB.reflectanceCoef),
-                           tvec3<T>(vec3(l_materialCB.albedo)), rayPayload.recursionDepth);
-
-    color = color + reflectedColor;
-    color += tvec4<T>(rayPayload.color);
-    rayPayload.dist += ctx.RayTCurrent();
-    rayPayload.color = vec4(color);
+void ClosestHit_Mandelbulb(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                           const Effects& effects) {
+    LitClosestHit<T, ProceduralPrimitiveAttributes>(
+        wave, traceRay, maxRayRecursionDepth(accuracy), effects, /*shadows*/ false,
+        [](ShaderContext& ctx, ClosestHitLane<T>& l, RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
+            if (ctx.HitKind() == 1) {
+                rayPayload.color = vec4(0.0f, 1.0f, 0.0f, 0.0f);
+                return false;
+            }
+            l.materialCB = materialCB(ctx);
+            l.normal = tvec3<T>(attr.normal);
+            l.color = MandelbulbSurfaceColor(tvec3<T>(ctx.WorldRayDirection()), l.normal, tvec4<T>(attr.color));
+            l.reflects = l.materialCB.reflectanceCoef > 0.001f;
+            l.reflectanceCoef = T(l.materialCB.reflectanceCoef);
+            l.f0 = tvec3<T>(vec3(l.materialCB.albedo));
+            return true;
+        },
+        [](ShaderContext& ctx, const ClosestHitLane<T>& l, RayPayload& rayPayload, const ProceduralPrimitiveAttributes&,
+           const tvec4<T>& reflectedColor) {
+            tvec4<T> color = l.color + reflectedColor;
+            color += tvec4<T>(rayPayload.color);
+            rayPayload.dist += ctx.RayTCurrent();
+            rayPayload.color = vec4(color);
+        });
 }
 
 template <typename T, typename L>
@@ -671,43 +724,47 @@ void Intersection_Julia(IntersectionWave& wave, const Accuracy& accuracy) {
     });
 }
 
+// PORT: written for waves (LitClosestHit; no shadow ray: the HLSL has it commented out).
 template <typename T>
-void ClosestHit_Julia(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                      RayPayload& rayPayload, const ProceduralPrimitiveAttributes& attr) {
-    [[maybe_unused]] PrecisionScope<T> scope;
-    const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
-    if (g_sceneCB.debugFlag) {
-        rayPayload.color = vec4(1.0f, 0.0f, 0.0f, 0.0f);
-        return;
-    }
-    const tvec3<T> normal = tvec3<T>(attr.normal);
-
-    // No shadow ray: the HLSL has it commented out.
-    const bool shadowRayHit = false;
-
-    // H1: with the local-unit t this point lies near the object-space ray origin, not on the surface.
-    const tvec3<T> pos = tvec3<T>(ctx.ObjectRayOrigin()) + T(ctx.RayTCurrent()) * tvec3<T>(ctx.ObjectRayDirection());
+void ClosestHit_Julia(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+                      const Effects& effects) {
     // PORT: MAX_RAY_RECURSION_DEPTH is the library's (maxRayRecursionDepth); with 0 the subtraction wraps, as the
     // HLSL's unsigned comparison does.
     const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
-    tvec4<T> albedo = tvec4<T>(T(3.5f) * colorSurface(pos, tvec2<T>(attr.color)), T(1));
-    if (rayPayload.recursionDepth == maxDepth - 1) albedo += T(1.65f) * hlsl::step(T(0), hlsl::abs(pos.y));
-
-    const T reflecCoef = T(0.1f);
-    tvec4<T> reflectedColor(T(0));
-    if (reflecCoef > T(0.001f))
-        reflectedColor = ReflectedColor(ctx, traceRay, maxDepth, normal, reflecCoef, tvec3<T>(albedo),
-                                        rayPayload.recursionDepth);
-
-    const T diffuseCoef = T(0.6f);
-    const T specularCoef = T(0.08f);
-    const T specularPower = T(0.2f);
-    const tvec4<T> phongColor =
-        CalculatePhongLighting(g_sceneCB, albedo, normal, shadowRayHit, diffuseCoef, specularCoef, specularPower,
-                               HitWorldPosition<T>(ctx), tvec3<T>(ctx.WorldRayDirection()));
-    tvec4<T> color = phongColor + reflectedColor;
-    color += tvec4<T>(rayPayload.color);
-    rayPayload.color = vec4(color);
+    LitClosestHit<T, ProceduralPrimitiveAttributes>(
+        wave, traceRay, maxDepth, effects, /*shadows*/ false,
+        [maxDepth](ShaderContext& ctx, ClosestHitLane<T>& l, RayPayload& rayPayload,
+                   const ProceduralPrimitiveAttributes& attr) {
+            l.sceneCB = sceneCB(ctx);
+            if (l.sceneCB.debugFlag) {
+                rayPayload.color = vec4(1.0f, 0.0f, 0.0f, 0.0f);
+                return false;
+            }
+            l.normal = tvec3<T>(attr.normal);
+            // H1: with the local-unit t this point lies near the object-space ray origin, not on the surface.
+            const tvec3<T> pos =
+                tvec3<T>(ctx.ObjectRayOrigin()) + T(ctx.RayTCurrent()) * tvec3<T>(ctx.ObjectRayDirection());
+            l.albedo = tvec4<T>(T(3.5f) * colorSurface(pos, tvec2<T>(attr.color)), T(1));
+            if (rayPayload.recursionDepth == maxDepth - 1) l.albedo += T(1.65f) * hlsl::step(T(0), hlsl::abs(pos.y));
+            const T reflecCoef = T(0.1f);
+            l.reflects = reflecCoef > T(0.001f);
+            l.reflectanceCoef = reflecCoef;
+            l.f0 = tvec3<T>(l.albedo);
+            return true;
+        },
+        [](ShaderContext& ctx, const ClosestHitLane<T>& l, RayPayload& rayPayload, const ProceduralPrimitiveAttributes&,
+           const tvec4<T>& reflectedColor) {
+            const T diffuseCoef = T(0.6f);
+            const T specularCoef = T(0.08f);
+            const T specularPower = T(0.2f);
+            const bool shadowRayHit = false;
+            const tvec4<T> phongColor =
+                CalculatePhongLighting(l.sceneCB, l.albedo, l.normal, shadowRayHit, diffuseCoef, specularCoef,
+                                       specularPower, HitWorldPosition<T>(ctx), tvec3<T>(ctx.WorldRayDirection()));
+            tvec4<T> color = phongColor + reflectedColor;
+            color += tvec4<T>(rayPayload.color);
+            rayPayload.color = vec4(color);
+        });
 }
 
 // Every export, with its math in T. The lambdas hold copies of the TraceRay arguments and the Accuracy, which the
@@ -720,10 +777,10 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
         "Raygen", in([traceRay, accuracy](RayGenerationWave& wave) { Raygen<T>(wave, traceRay, accuracy); }));
     lib.addMiss<RayPayload>("Miss", Miss);
     lib.addMiss<ShadowRayPayload>("Miss_Shadow", Miss_Shadow);
-    lib.addClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
-        "ClosestHit_Triangle", in([traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
-                                                                const BuiltInTriangleIntersectionAttributes& attr) {
-            ClosestHit_Triangle<T>(ctx, traceRay, accuracy, effects, payload, attr);
+    // The closest hits are written for waves.
+    lib.addWaveClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
+        "ClosestHit_Triangle", in([traceRay, accuracy, effects](ClosestHitWave& wave) {
+            ClosestHit_Triangle<T>(wave, traceRay, accuracy, effects);
         }));
     // Each intersection shader below ends with its ReportHit (the debug-flag path returns right after it), as in
     // the HLSL: ReportHitEnd::Return (docs/emulator.md, "Ending an intersection shader").
@@ -732,31 +789,27 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
             withLaneType<T>(wave, [&]<class L>() { Intersection_Julia<T, L>(wave, accuracy); });
         }),
         ReportHitEnd::Return);
-    lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
-        "ClosestHit_Julia",
-        in([traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
-            ClosestHit_Julia<T>(ctx, traceRay, accuracy, payload, attr);
+    lib.addWaveClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
+        "ClosestHit_Julia", in([traceRay, accuracy, effects](ClosestHitWave& wave) {
+            ClosestHit_Julia<T>(wave, traceRay, accuracy, effects);
         }));
     // Pac-man: a whole wave's lanes a call, for RaySignedDistancePrimitiveTestQueue's refilled lanes.
     lib.addWaveIntersection<ProceduralPrimitiveAttributes>("Intersection_Pacman", kMaxWaveWidth, in([accuracy](IntersectionWave& wave) {
             withLaneType<T>(wave, [&]<class L>() { Intersection_Pacman<T, L>(wave, accuracy); });
         }),
         ReportHitEnd::Return);
-    lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
-        "ClosestHit_Pacman",
-        in([traceRay, accuracy, effects](ShaderContext& ctx, RayPayload& payload,
-                                         const ProceduralPrimitiveAttributes& attr) {
-            ClosestHit_Pacman<T>(ctx, traceRay, accuracy, effects, payload, attr);
+    lib.addWaveClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
+        "ClosestHit_Pacman", in([traceRay, accuracy, effects](ClosestHitWave& wave) {
+            ClosestHit_Pacman<T>(wave, traceRay, accuracy, effects);
         }));
     // Mandelbulb: a whole wave's lanes a call, for MandelbulbDistanceQueue's refilled lanes.
     lib.addWaveIntersection<ProceduralPrimitiveAttributes>("Intersection_Mandelbulb", kMaxWaveWidth,
         in([accuracy](IntersectionWave& wave) {
             withLaneType<T>(wave, [&]<class L>() { Intersection_Mandelbulb<T, L>(wave, accuracy); });
         }), ReportHitEnd::Return);
-    lib.addClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
-        "ClosestHit_Mandelbulb",
-        in([traceRay, accuracy](ShaderContext& ctx, RayPayload& payload, const ProceduralPrimitiveAttributes& attr) {
-            ClosestHit_Mandelbulb<T>(ctx, traceRay, accuracy, payload, attr);
+    lib.addWaveClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
+        "ClosestHit_Mandelbulb", in([traceRay, accuracy, effects](ClosestHitWave& wave) {
+            ClosestHit_Mandelbulb<T>(wave, traceRay, accuracy, effects);
         }));
 }
 
