@@ -341,6 +341,19 @@ struct ClosestHitLane {
     tvec3<T> D;
     RayPayload reflectionPayload;
     bool reflected = false;
+
+    // The material's reflection (read into materialCB): reflectanceCoef > 0.001 reflects, with Fresnel's `fresnelF0`.
+    void reflectMaterial(const tvec3<T>& fresnelF0) {
+        reflects = materialCB.reflectanceCoef > 0.001f;
+        reflectanceCoef = T(materialCB.reflectanceCoef);
+        f0 = fresnelF0;
+    }
+    // CalculatePhongLighting with the material's coefficients, at HitWorldPosition() seen along WorldRayDirection().
+    tvec4<T> materialPhong(const ShaderContext& ctx) const {
+        return CalculatePhongLighting(sceneCB, albedo, normal, shadowRayHit, T(materialCB.diffuseCoef),
+                                      T(materialCB.specularCoef), T(materialCB.specularPower), HitWorldPosition<T>(ctx),
+                                      tvec3<T>(ctx.WorldRayDirection()));
+    }
 };
 
 // The shape of the closest hits, over the lanes of a wave (emulator/closest_hit_wave.h), lane by lane the HLSL's:
@@ -446,17 +459,12 @@ void ClosestHit_Triangle(ClosestHitWave& wave, const TraceRayArgumentSet& traceR
             const vec3 storedNormal = FirstVertexNormal(ctx, kVertexBuffers);
             l.normal = -tvec3<T>(storedNormal);
             l.albedo = tvec4<T>(l.materialCB.albedo);
-            l.reflects = l.materialCB.reflectanceCoef > 0.001f;
-            l.reflectanceCoef = T(l.materialCB.reflectanceCoef);
-            l.f0 = tvec3<T>(l.albedo);
+            l.reflectMaterial(tvec3<T>(l.albedo));
             return true;
         },
         [](ShaderContext& ctx, const ClosestHitLane<T>& l, RayPayload& rayPayload,
            const BuiltInTriangleIntersectionAttributes&, const tvec4<T>& reflectedColor) {
-            const tvec4<T> phongColor = CalculatePhongLighting(
-                l.sceneCB, l.albedo, l.normal, l.shadowRayHit, T(l.materialCB.diffuseCoef),
-                T(l.materialCB.specularCoef), T(l.materialCB.specularPower), HitWorldPosition<T>(ctx),
-                tvec3<T>(ctx.WorldRayDirection()));
+            const tvec4<T> phongColor = l.materialPhong(ctx);
             tvec4<T> color = phongColor + reflectedColor;
             color += tvec4<T>(rayPayload.color);
             rayPayload.dist += ctx.RayTCurrent();
@@ -599,17 +607,12 @@ void ClosestHit_Pacman(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay
             l.materialCB = materialCB(ctx);
             l.normal = tvec3<T>(attr.normal);
             l.albedo = tvec4<T>(l.materialCB.albedo);
-            l.reflects = l.materialCB.reflectanceCoef > 0.001f;
-            l.reflectanceCoef = T(l.materialCB.reflectanceCoef);
-            l.f0 = tvec3<T>(l.albedo);
+            l.reflectMaterial(tvec3<T>(l.albedo));
             return true;
         },
         [](ShaderContext& ctx, const ClosestHitLane<T>& l, RayPayload& rayPayload,
            const ProceduralPrimitiveAttributes& attr, const tvec4<T>& reflectedColor) {
-            const tvec4<T> phongColor = CalculatePhongLighting(
-                l.sceneCB, l.albedo, l.normal, l.shadowRayHit, T(l.materialCB.diffuseCoef),
-                T(l.materialCB.specularCoef), T(l.materialCB.specularPower), HitWorldPosition<T>(ctx),
-                tvec3<T>(ctx.WorldRayDirection()));
+            const tvec4<T> phongColor = l.materialPhong(ctx);
             tvec4<T> color = tvec4<T>(attr.color) * (phongColor + reflectedColor);
             color += tvec4<T>(rayPayload.color);
             rayPayload.dist += ctx.RayTCurrent();
@@ -673,9 +676,7 @@ void ClosestHit_Mandelbulb(ClosestHitWave& wave, const TraceRayArgumentSet& trac
             l.materialCB = materialCB(ctx);
             l.normal = tvec3<T>(attr.normal);
             l.color = MandelbulbSurfaceColor(tvec3<T>(ctx.WorldRayDirection()), l.normal, tvec4<T>(attr.color));
-            l.reflects = l.materialCB.reflectanceCoef > 0.001f;
-            l.reflectanceCoef = T(l.materialCB.reflectanceCoef);
-            l.f0 = tvec3<T>(vec3(l.materialCB.albedo));
+            l.reflectMaterial(tvec3<T>(vec3(l.materialCB.albedo)));
             return true;
         },
         [](ShaderContext& ctx, const ClosestHitLane<T>& l, RayPayload& rayPayload, const ProceduralPrimitiveAttributes&,

@@ -100,13 +100,18 @@ RayDesc mixedRay(uint32_t launch) {
     return ray;
 }
 
-TEST(RayGenerationWave, EveryLaneTracesAsItWouldAlone) {
-    WaveRig w(uvec2(7, 5));  // 35 launches: waves that do not divide them
-    const auto tri = w.r.h.blas({w.r.h.triangles(triAt(0))});
-    const auto box = w.r.h.blas({w.r.h.aabbs({unitBox()}, GEOMETRY_FLAG_OPAQUE)});
+// The scene of mixedRay: a triangle at z = 0 (instance 0) and an opaque unit box at z = 10 (instance 1).
+void triangleAndBox(Harness& h) {
+    const auto tri = h.blas({h.triangles(triAt(0))});
+    const auto box = h.blas({h.aabbs({unitBox()}, GEOMETRY_FLAG_OPAQUE)});
     Matrix3x4 boxAt = Matrix3x4::identity();
     boxAt.m[2][3] = 10.0f;
-    w.r.h.tlas({Harness::instance(tri, 0), Harness::instance(box, 1, boxAt)});
+    h.tlas({Harness::instance(tri, 0), Harness::instance(box, 1, boxAt)});
+}
+
+TEST(RayGenerationWave, EveryLaneTracesAsItWouldAlone) {
+    WaveRig w(uvec2(7, 5));  // 35 launches: waves that do not divide them
+    triangleAndBox(w.r.h);
     w.r.recursion(3);
     w.rayFor = mixedRay;
     w.traces = [](uint32_t launch) { return launch != 30; };  // a lane that traces nothing
@@ -275,11 +280,7 @@ struct ClosestHitWaveRig : WaveRig {
 
 TEST(ClosestHitWave, EveryLaneRunsAsItWouldAlone) {
     ClosestHitWaveRig w(uvec2(7, 5));  // 35 launches: waves that do not divide them
-    const auto tri = w.r.h.blas({w.r.h.triangles(triAt(0))});
-    const auto box = w.r.h.blas({w.r.h.aabbs({unitBox()}, GEOMETRY_FLAG_OPAQUE)});
-    Matrix3x4 boxAt = Matrix3x4::identity();
-    boxAt.m[2][3] = 10.0f;
-    w.r.h.tlas({Harness::instance(tri, 0), Harness::instance(box, 1, boxAt)});
+    triangleAndBox(w.r.h);
 
     const DispatchResult alone = w.run({"HG_TriW", "HG_BoxS_noAH"}, 1, continueMode());
     const std::vector<Probe> expected = w.results;
