@@ -122,7 +122,7 @@ void gatherAlone(ThreadState& ts, RayState& rs, const Site& site, std::vector<Ca
 void gatherOrderedCandidates(std::span<GatherRay> rays) {
     // Rays that take FirstHit go alone (their candidates are processed inside the traversal); the others traverse
     // in packets of the rays that share a TLAS, in the order of their lanes.
-    std::array<bool, kMaxGatherPacket> pending{};
+    std::array<bool, kMaxWaveWidth> pending{};
     for (size_t i = 0; i < rays.size(); ++i) {
         GatherRay& ray = rays[i];
         const GatherMode mode = traversalMode(*ray.ts, *ray.rs);
@@ -142,7 +142,7 @@ void gatherOrderedCandidates(std::span<GatherRay> rays) {
         std::array<const GatherRequest*, kMaxGatherPacket> requests{};
         std::array<size_t, kMaxGatherPacket> index{};
         size_t count = 0;
-        for (size_t i = first; i < rays.size(); ++i)
+        for (size_t i = first; i < rays.size() && count < size_t(kMaxGatherPacket); ++i)
             if (pending[i] && rays[i].request.tlas == rays[first].request.tlas) {
                 pending[i] = false;
                 index[count] = i;

@@ -239,7 +239,7 @@ int waveWidth(const DispatchOptions& options) {
     return int(options.waveWidth);
 }
 
-// The launches of a wave: a block of the tile as square as the width allows (4x4 for 16 lanes), so that its rays
+// The launches of a wave: a block of the tile as square as the width allows (8x4 for 32 lanes, 4x4 for 16), so that its rays
 // start close together and meet the same records.
 uvec2 waveBlock(int width) {
     uint32_t w = 1;

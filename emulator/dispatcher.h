@@ -58,9 +58,9 @@ struct DispatchOptions {
     bool specialise = true;
     // Lanes per wave (docs/emulator.md, "Waves"): each worker runs up to this many launches together, their rays
     // traversing as a packet and their intersection shaders running once per record over the lanes that reach it.
-    // 1..kMaxWaveWidth (16); images, diagnostics and statistics are the same for every width. An observed or
+    // 1..kMaxWaveWidth (32); images, diagnostics and statistics are the same for every width. An observed or
     // profiled dispatch runs one lane per wave, so that each launch's events and stage times stay its own.
-    uint32_t waveWidth = 16;
+    uint32_t waveWidth = 32;
 };
 
 // ID3D12GraphicsCommandList::Dispatch with a compute pipeline state whose shader is `ComputeShader`, a compute

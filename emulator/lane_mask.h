@@ -7,8 +7,9 @@
 
 namespace refray::dxr {
 
-// The widest wave: 16 lanes, the float lanes of one AVX-512 register (docs/emulator.md, "Waves").
-inline constexpr int kMaxWaveWidth = 16;
+// The widest wave, and the default: 32 lanes (docs/emulator.md, "Waves": the width a wave's record groups and march
+// queues batch over; the SIMD math runs in 8-float lanes whatever the width).
+inline constexpr int kMaxWaveWidth = 32;
 
 class LaneMask {
 public:

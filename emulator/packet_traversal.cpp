@@ -17,7 +17,7 @@
 
 namespace refray::dxr::detail {
 
-static_assert(kMaxWaveWidth <= kMaxGatherPacket, "a wave's rays gather as one Embree packet");
+
 
 namespace {
 

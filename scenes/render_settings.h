@@ -63,8 +63,8 @@ struct RenderSettings {
     bool profileStages = false;
     // DispatchOptions::specialise: traversal shortcuts that change no result.
     bool specialise = true;
-    // DispatchOptions::waveWidth: lanes per wave (1..16); the image is the same for every width.
-    uint32_t waveWidth = 16;
+    // DispatchOptions::waveWidth: lanes per wave (1..32); the image is the same for every width.
+    uint32_t waveWidth = 32;
     // Empty: the emulator runs the dispatch (dxr::Device::dispatchRays).
     DispatchBackend backend;
     // The same for a compute dispatch (dxr::Device::dispatch). A render with `backend` set and this empty refuses

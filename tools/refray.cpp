@@ -184,7 +184,7 @@ struct RenderOptions {
     bool stats = false;
     std::string statsJson;  // --stats-json FILE
     bool noShortcuts = false;  // --no-shortcuts: DispatchOptions::specialise off
-    uint32_t waveWidth = 16;   // --wave-width: DispatchOptions::waveWidth
+    uint32_t waveWidth = 32;   // --wave-width: DispatchOptions::waveWidth
     bool noStageTimes = false;  // --no-stage-times: --stats without DispatchOptions::profileStages
     std::string order = "ordered";
     uint64_t seed = 0;  // RenderSettings::seed (the first batch's) and the adversarial order's seed
@@ -497,8 +497,8 @@ int main(int argc, char** argv) {
     render->add_option("--wave-width", ro.waveWidth,
                        "Lanes per wave of the emulator (docs/emulator.md, \"Waves\"): launches run together, their rays "
                        "traverse as a packet and their intersection shaders run once per record over the lanes that "
-                       "reach it. The image is the same for every width (default 16)")
-        ->check(CLI::Range(1, 16));
+                       "reach it. The image is the same for every width (default 32)")
+        ->check(CLI::Range(1, 32));
     render->add_option("--aov", ro.aov,
                        "Write an index map instead of the render: record|instance|geometry|primitive|hitgroup|depth "
                        "of each pixel's primary ray, false-coloured, with a legend (-o FILE.exr: the values "

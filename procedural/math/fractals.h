@@ -458,7 +458,7 @@ vec2<T> raycast(const vec3<T>& ro, const vec3<T>& rd, const vec4<T>& c = kc<T>()
     return raycastResult(b, m);
 }
 
-// The most rays raycastQueue takes: a wave's (16).
+// The most rays raycastQueue takes: a wave's (32).
 inline constexpr int kMaxRaycastQueue = kMaxMarchQueue;
 
 // Lane i of a march over lanes, and its writing.

@@ -13,8 +13,8 @@
 
 namespace refray::procedural::math {
 
-// The most rays a march queue takes: a wave's (16).
-inline constexpr int kMaxMarchQueue = 16;
+// The most rays a march queue takes: a wave's (32).
+inline constexpr int kMaxMarchQueue = 32;
 
 // Marches rays 0..count-1 over the N lanes of L, each for at most maxSteps steps (none when maxSteps <= 0):
 // - marches(k): whether ray k marches at all (a ray that does not keeps the state it starts with);

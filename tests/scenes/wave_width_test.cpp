@@ -33,7 +33,7 @@ void expectSameForEveryWidth(const std::string& file, RenderSettings settings) {
     Scene scene(loadSceneFile(kSourceDir + "/scenes/" + file));
     settings.width = 40;
     settings.height = 24;
-    settings.waveWidth = 16;
+    settings.waveWidth = 32;  // the default
     settings.threads = 1;
     const RenderResult reference = scene.render(settings);
     for (const Variant v : {Variant{1, 1}, Variant{3, 2}, Variant{8, 1}, Variant{16, 2}}) {
