@@ -17,8 +17,6 @@
 
 namespace refray::dxr::detail {
 
-
-
 namespace {
 
 void emitCandidate(const ThreadState& ts, const RayState& rs, const Candidate& c) {
@@ -95,8 +93,8 @@ void runIntersectionGroup(Wave& wave, LaneMask group) {
 }  // namespace
 
 void traversePacket(Wave& wave, LaneMask lanes) {
-    // The rays gather their candidates as one Embree packet (each ray's candidates, order and statistics are those
-    // it gets alone).
+    // The rays gather their candidates in Embree packets of up to 16 (each ray's candidates, order and statistics are
+    // those it gets alone).
     std::array<GatherRay, kMaxWaveWidth> gathers;
     std::array<int, kMaxWaveWidth> laneOf{};
     size_t count = 0;

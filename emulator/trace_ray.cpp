@@ -60,7 +60,6 @@ std::string vec3Values(const vec3& v) {
     return std::to_string(v.x) + "," + std::to_string(v.y) + "," + std::to_string(v.z);
 }
 
-
 // validateRay's reports, for a ray that is not plainly valid: out of line, so that the common case's frame (and the
 // frames of TraceRay and RayQuery around it) stays small.
 [[gnu::cold, gnu::noinline]] void reportRay(ThreadState& ts, const Site& site, const RayDesc& ray, bool& ok,

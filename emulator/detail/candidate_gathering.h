@@ -1,4 +1,4 @@
-// Candidate gathering and order for the TraceRays of a wave (one Embree packet) and for a RayQuery. Internal to the
+// Candidate gathering and order for the TraceRays of a wave (Embree packets) and for a RayQuery. Internal to the
 // emulator.
 #pragma once
 
@@ -22,9 +22,10 @@ struct GatherRay {
     std::exception_ptr error;
 };
 
-// Gathers the candidates of each of up to kMaxGatherPacket rays rs.ray in rs.tlas (Embree broad phase + exact tests;
+// Gathers the candidates of each of up to kMaxWaveWidth rays rs.ray in rs.tlas (Embree broad phase + exact tests;
 // FLAG-12 skips) into its ts->candidates, in the order TRV-4 meets them (GEN-3). The rays that share a TLAS traverse
-// as one Embree packet, and each gets the candidates, order and statistics it gets alone. A FirstHit ray (GatherMode)
+// in Embree packets of up to kMaxGatherPacket, in lane order, and each gets the candidates, order and statistics it
+// gets alone. A FirstHit ray (GatherMode)
 // traverses alone, has its candidates processed as Embree meets them and leaves its ts->candidates empty. What fails
 // for one ray goes to its `error`; the others go on.
 void gatherOrderedCandidates(std::span<GatherRay> rays);

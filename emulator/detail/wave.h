@@ -77,10 +77,12 @@ void runWave(Wave& wave, std::span<const uvec3> launches, const LaunchFunction& 
 void openWave(Wave& wave, size_t lanes);
 
 // The TraceRays of `lanes`, one per lane, issued together by a shader written for waves that runs on the wave's own
-// stack (ray_generation_wave.h): lane i's is calls[i] from the invocation callers[i]. Each lane's TraceRay is the one
-// ShaderContext::TraceRay makes (the same checks, events, counts, candidates, shaders and payload), and their rays
-// traverse as one packet. Closest-hit shaders run on their lanes' fibers (their own TraceRays park as any lane's);
-// miss shaders on the wave's stack. What stops a lane's launch goes to failures[i].
+// stack (tracing_wave.h: ray generation or closest hit): lane i's is calls[i] from the invocation callers[i]. Each
+// lane's TraceRay is the one ShaderContext::TraceRay makes (the same checks, events, counts, candidates, shaders and
+// payload), and their rays traverse as one packet. Closest-hit shaders written for waves run once per shader over the
+// lanes that selected them, on the wave's stack (their TraceRays come back here); other closest-hit shaders on their
+// lanes' fibers (their own TraceRays park as any lane's); miss shaders on the wave's stack. What stops a lane's
+// launch goes to failures[i].
 void traceRaysInWave(Wave& wave, const std::array<Invocation*, kMaxWaveWidth>& callers,
                      const TraceRayCall* calls, LaneMask lanes,
                      std::array<std::exception_ptr, kMaxWaveWidth>& failures);
