@@ -20,6 +20,7 @@
 #include "emulator/detail/wave.h"
 #include "emulator/device.h"
 #include "emulator/limits.h"
+#include "emulator/compute_wave.h"
 #include "emulator/ray_generation_wave.h"
 
 namespace refray::dxr {
@@ -165,13 +166,17 @@ void recordLaunchFailure(ThreadState& ts, DispatchState& ds, const detail::Invoc
     }
 }
 
+// The launch's invocation: the compute shader's, or the ray generation shader's (its record's).
+detail::Invocation launchInvocation(ThreadState& ts, const DispatchState& ds) {
+    return ds.computeShader
+               ? detail::invocation(ts, ShaderStage::Compute, ds.computeShader, nullptr, 0)
+               : detail::invocation(ts, ShaderStage::RayGeneration, ds.rayGenRecord.entry->shader, &ds.rayGenRecord, 0);
+}
+
 // One launch: the ray generation shader at `launch`, unless an earlier launch has stopped the dispatch.
 void runLaunch(ThreadState& ts, DispatchState& ds, uvec3 launch) {
     if (!startLaunch(ts, ds, launch)) return;
-    detail::Invocation inv =
-        ds.computeShader
-            ? detail::invocation(ts, ShaderStage::Compute, ds.computeShader, nullptr, 0)
-            : detail::invocation(ts, ShaderStage::RayGeneration, ds.rayGenRecord.entry->shader, &ds.rayGenRecord, 0);
+    detail::Invocation inv = launchInvocation(ts, ds);
     try {
         if (!ds.computeShader) detail::checkGlobalSignature(ts, detail::siteOf(inv), *ds.rayGenRecord.entry);
         detail::invoke(ts, inv, nullptr, nullptr);
@@ -180,12 +185,11 @@ void runLaunch(ThreadState& ts, DispatchState& ds, uvec3 launch) {
     }
 }
 
-// The launches of a wave whose ray generation shader is written for waves (emulator/ray_generation_wave.h): each
-// lane starts as runLaunch starts it, the shader runs once over the lanes on the worker's own stack, and each lane's
-// failure is recorded as runLaunch records it.
+// The launches of a wave whose ray generation or compute shader is written for waves (emulator/ray_generation_wave.h,
+// emulator/compute_wave.h): each lane starts as runLaunch starts it, the shader runs once over the lanes on the
+// worker's own stack, and each lane's failure is recorded as runLaunch records it.
 void runLaunchWave(Wave& wave, DispatchState& ds, std::span<const uvec3> launches) {
     detail::openWave(wave, launches.size());
-    const ShaderExport& shader = *ds.rayGenRecord.entry->shader;
     std::array<std::optional<detail::Invocation>, kMaxWaveWidth> invocations;
     std::array<std::optional<ShaderContext>, kMaxWaveWidth> contexts;
     std::array<ShaderContext*, kMaxWaveWidth> lanes{};
@@ -195,23 +199,28 @@ void runLaunchWave(Wave& wave, DispatchState& ds, std::span<const uvec3> launche
         ThreadState& ts = wave.lanes[i].ts;
         wave.lanes[i].launch = launches[i];
         if (!startLaunch(ts, ds, launches[i])) continue;
-        const detail::Invocation& inv = invocations[i].emplace(
-            detail::invocation(ts, ShaderStage::RayGeneration, &shader, &ds.rayGenRecord, 0));
-        try {
-            detail::checkGlobalSignature(ts, detail::siteOf(inv), *ds.rayGenRecord.entry);
-        } catch (...) {
-            recordLaunchFailure(ts, ds, inv, std::current_exception());
-            continue;
+        const detail::Invocation& inv = invocations[i].emplace(launchInvocation(ts, ds));
+        if (!ds.computeShader) {
+            try {
+                detail::checkGlobalSignature(ts, detail::siteOf(inv), *ds.rayGenRecord.entry);
+            } catch (...) {
+                recordLaunchFailure(ts, ds, inv, std::current_exception());
+                continue;
+            }
         }
         callerSections[i] = detail::beginInvocation(ts, inv);
         lanes[i] = &contexts[i].emplace(*invocations[i]);
         active.set(int(i));
     }
     if (active.empty()) return;
-    RayGenerationWave shaderWave(lanes, active, &wave);
+    std::optional<RayGenerationWave> rayGeneration;
+    std::optional<ComputeWave> compute;
+    ShaderWave& shaderWave = ds.computeShader ? static_cast<ShaderWave&>(compute.emplace(lanes, active, &wave))
+                                              : rayGeneration.emplace(lanes, active, &wave);
     std::exception_ptr escaped;
     try {
-        shader.waveRayGeneration(shaderWave);
+        if (compute) ds.computeShader->waveCompute(*compute);
+        else ds.rayGenRecord.entry->shader->waveRayGeneration(*rayGeneration);
     } catch (...) {
         escaped = std::current_exception();  // not one lane's: it stops every lane still running the shader
     }
@@ -256,9 +265,11 @@ void runTiles(DispatchState& ds, const LaunchRegion& region, Waves& waves) {
     const int width = waveWidth(options);
     const uvec2 block = waveBlock(width);
     const detail::LaunchFunction launch = [&ds](ThreadState& ts, uvec3 at) { runLaunch(ts, ds, at); };
-    // A ray generation shader written for waves runs once a wave; one lane at a time it runs alone, on its fiber.
-    const bool waveRayGeneration =
-        width > 1 && !ds.computeShader && ds.rayGenRecord.entry && ds.rayGenRecord.entry->shader->waveRayGeneration;
+    // A ray generation or compute shader written for waves runs once a wave; one lane at a time it runs alone, on its
+    // fiber.
+    const bool waveShader =
+        width > 1 && (ds.computeShader ? bool(ds.computeShader->waveCompute)
+                                       : ds.rayGenRecord.entry && ds.rayGenRecord.entry->shader->waveRayGeneration);
     const int arenaThreads = options.threads ? int(options.threads) : tbb::task_arena::automatic;
     tbb::task_arena arena(arenaThreads);
     arena.execute([&] {
@@ -275,7 +286,7 @@ void runTiles(DispatchState& ds, const LaunchRegion& region, Waves& waves) {
                                 for (uint32_t x = x0; x < std::min(x0 + block.x, range.cols().end()); ++x)
                                     launches[count++] = uvec3(x, y, z);
                             const std::span<const uvec3> lanes(launches.data(), count);
-                            if (waveRayGeneration) runLaunchWave(wave, ds, lanes);
+                            if (waveShader) runLaunchWave(wave, ds, lanes);
                             else detail::runWave(wave, lanes, launch);
                         }
                 if (options.progress) options.progress->advance(range.rows().size() * range.cols().size());

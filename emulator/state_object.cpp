@@ -9,6 +9,7 @@
 
 #include "core/strings.h"
 #include "emulator/closest_hit_wave.h"
+#include "emulator/compute_wave.h"
 #include "emulator/intersection_wave.h"
 #include "emulator/ray_generation_wave.h"
 #include "emulator/limits.h"
@@ -56,16 +57,33 @@ void ShaderLibrary::addWaveClosestHit(std::string name, TypeTag payload, TypeTag
     add(std::move(e));
 }
 
-void ShaderLibrary::addCompute(std::string name, uvec3 numThreads, std::function<void(ShaderContext&)> fn) {
+namespace {
+
+// A compute export of `numThreads`: D3D12's limits on [numthreads] checked.
+ShaderExport computeExport(std::string name, uvec3 numThreads, ErasedShader function) {
     REFRAY_CHECK(numThreads.x >= 1 && numThreads.y >= 1 && numThreads.z >= 1 && numThreads.z <= 64 &&
                      uint64_t(numThreads.x) * numThreads.y * numThreads.z <= 1024 && numThreads.x <= 1024 &&
                      numThreads.y <= 1024,
                  "compute shader '" << name << "': numthreads(" << numThreads.x << ", " << numThreads.y << ", "
                                     << numThreads.z << ") is outside D3D12's limits (x, y <= 1024, z <= 64, "
                                     << "x*y*z <= 1024)");
-    ShaderExport e{std::move(name), ShaderStage::Compute, {}, {}, {},
-                   [fn = std::move(fn)](ShaderContext& c, void*, const void*) { fn(c); }};
+    ShaderExport e{std::move(name), ShaderStage::Compute, {}, {}, {}, std::move(function)};
     e.numThreads = numThreads;
+    return e;
+}
+
+}  // namespace
+
+void ShaderLibrary::addCompute(std::string name, uvec3 numThreads, std::function<void(ShaderContext&)> fn) {
+    add(computeExport(std::move(name), numThreads,
+                      [fn = std::move(fn)](ShaderContext& c, void*, const void*) { fn(c); }));
+}
+
+void ShaderLibrary::addWaveCompute(std::string name, uvec3 numThreads, WaveComputeShader fn) {
+    REFRAY_CHECK(fn, "shader export '" << name << "' has no function");
+    ShaderExport e = computeExport(std::move(name), numThreads,
+                                   [fn](ShaderContext& c, void*, const void*) { ComputeWave::runAlone(fn, c); });
+    e.waveCompute = std::move(fn);
     add(std::move(e));
 }
 

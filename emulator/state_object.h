@@ -45,9 +45,11 @@ using ErasedShader = std::function<void(ShaderContext&, void* payload, const voi
 class IntersectionWave;
 class RayGenerationWave;
 class ClosestHitWave;
+class ComputeWave;
 using WaveIntersectionShader = std::function<void(IntersectionWave&)>;
 using WaveRayGenerationShader = std::function<void(RayGenerationWave&)>;
 using WaveClosestHitShader = std::function<void(ClosestHitWave&)>;
+using WaveComputeShader = std::function<void(ComputeWave&)>;
 
 // How an intersection shader ends when one of its ReportHit calls ends the search (IS-10: FLAG-8, or an any-hit
 // shader's AcceptHitAndEndSearch). docs/emulator.md, "Ending an intersection shader".
@@ -84,6 +86,8 @@ struct ShaderExport {
     // Closest hit written for waves: the lanes of a wave whose rays selected it call this once; `function` runs it
     // for one lane alone.
     WaveClosestHitShader waveClosestHit = {};
+    // Compute written for waves: a wave of dispatch threads calls this once; `function` runs it for one thread alone.
+    WaveComputeShader waveCompute = {};
 };
 
 // A DXIL library: named shader exports. Signatures mirror HLSL entry points:
@@ -98,6 +102,9 @@ public:
     // [numthreads(x, y, z)] [shader("compute")] void CS(uint3 id : SV_DispatchThreadID): run by Device::dispatch, not
     // part of the ray-tracing pipeline (no identifier); it reads its thread ids from ShaderContext.
     void addCompute(std::string name, uvec3 numThreads, std::function<void(ShaderContext&)> fn);
+    // A compute shader written for waves (emulator/compute_wave.h): one call runs a wave of its threads, whose wave
+    // calls (a RayQuery's procedural tests) it makes together through ComputeWave::CallsInLoop.
+    void addWaveCompute(std::string name, uvec3 numThreads, WaveComputeShader fn);
     template <class Attributes>
     void addIntersection(std::string name, std::function<void(ShaderContext&)> fn,
                          ReportHitEnd end = ReportHitEnd::Unwind) {

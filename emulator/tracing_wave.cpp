@@ -7,23 +7,14 @@
 
 namespace refray::dxr {
 
-TracingWave::TracingWave(const std::array<ShaderContext*, kMaxWaveWidth>& contexts, LaneMask active,
-                         detail::Wave* wave)
-    : contexts_(contexts), active_(active), wave_(wave) {}
-
-void TracingWave::fail(int lane, std::exception_ptr failure) {
-    failures_[size_t(lane)] = std::move(failure);
-    active_.clear(lane);
-}
-
 void TracingWave::TraceRay(LaneMask lanes, std::span<const TraceRayCall> calls) {
-    const LaneMask tracing(lanes.bits() & active_.bits());
+    const LaneMask tracing(lanes.bits() & active().bits());
     REFRAY_ASSERT(tracing.empty() || size_t(31 - std::countl_zero(tracing.bits())) < calls.size(),
                   "TraceRay for lanes " << tracing.bits() << " with " << calls.size() << " calls");
-    if (!wave_) {
+    if (runsAlone()) {
         for (int i : tracing) {
             try {
-                contexts_[size_t(i)]->TraceRay(calls[size_t(i)]);
+                context(i).TraceRay(calls[size_t(i)]);
             } catch (...) {
                 fail(i, std::current_exception());
             }
@@ -32,9 +23,9 @@ void TracingWave::TraceRay(LaneMask lanes, std::span<const TraceRayCall> calls) 
     }
     // RAY-2 holds (ray generation and closest-hit shaders may trace), and no ReportHit can have ended either stage.
     std::array<detail::Invocation*, kMaxWaveWidth> callers{};
-    for (int i : tracing) callers[size_t(i)] = &contexts_[size_t(i)]->inv_;
+    for (int i : tracing) callers[size_t(i)] = &context(i).inv_;
     std::array<std::exception_ptr, kMaxWaveWidth> failures{};
-    detail::traceRaysInWave(*wave_, callers, calls.data(), tracing, failures);
+    detail::traceRaysInWave(*wave(), callers, calls.data(), tracing, failures);
     for (int i : tracing)
         if (failures[size_t(i)]) fail(i, std::move(failures[size_t(i)]));
 }

@@ -1,8 +1,9 @@
 // TracingWave: a shader run once for the lanes of a wave that issues their TraceRays together, as a GPU runs one
-// shader over the threads of a wave. The shader runs its code lane by lane through each lane's ShaderContext
-// (forEachLane) and its lanes' TraceRays as one call (TraceRay): their rays traverse as one packet (emulator/wave.h),
-// their closest-hit and miss shaders run, and the shader goes on with every lane's payload filled in. Two stages are
-// written this way: ray generation (emulator/ray_generation_wave.h) and closest hit (emulator/closest_hit_wave.h).
+// shader over the threads of a wave (emulator/shader_wave.h). The shader runs its code lane by lane through each
+// lane's ShaderContext (forEachLane) and its lanes' TraceRays as one call (TraceRay): their rays traverse as one packet
+// (emulator/wave.h), their closest-hit and miss shaders run, and the shader goes on with every lane's payload filled
+// in. Two stages are written this way: ray generation (emulator/ray_generation_wave.h) and closest hit
+// (emulator/closest_hit_wave.h).
 //
 // Every lane's TraceRay is the one ShaderContext::TraceRay makes for it (its checks and diagnostics, events,
 // statistics, candidates, shaders and payload), so every lane's result is the one a one-lane wave gives. A lane leaves
@@ -14,41 +15,14 @@
 #include <span>
 #include <utility>
 
-#include "emulator/lane_mask.h"
-#include "emulator/shader_api.h"
+#include "emulator/shader_wave.h"
 #include "emulator/trace_ray_call.h"
 
 namespace refray::dxr {
 
-namespace detail {
-struct Wave;
-}
-
-class TracingWave {
+class TracingWave : public ShaderWave {
 public:
-    // The lanes `active` of `contexts` (the others may be null); `wave` is the wave that runs them, or null for a
-    // lane that runs alone (each lane's TraceRay is then its ShaderContext::TraceRay).
-    TracingWave(const std::array<ShaderContext*, kMaxWaveWidth>& contexts, LaneMask active, detail::Wave* wave);
-    TracingWave(const TracingWave&) = delete;
-    TracingWave& operator=(const TracingWave&) = delete;
-
-    // The lanes the shader still runs for, and lane `lane`'s context.
-    LaneMask active() const { return active_; }
-    bool isActive(int lane) const { return active_.test(lane); }
-    ShaderContext& lane(int lane) const { return *contexts_[size_t(lane)]; }
-
-    // f(lane, ShaderContext&) for every active lane, in lane order. Anything `f` throws for a lane (a rule that
-    // stops its launch) takes that lane out of the wave and is rethrown to its launch later.
-    template <class F>
-    void forEachLane(F&& f) {
-        for (int i : active_) {
-            try {
-                f(i, *contexts_[size_t(i)]);
-            } catch (...) {
-                fail(i, std::current_exception());
-            }
-        }
-    }
+    using ShaderWave::ShaderWave;
 
     // TraceRay for every active lane of `lanes`, lane i's with calls[i] (its payload is lane i's variable, filled in
     // when this returns). Lanes outside `lanes` trace nothing; `calls` reaches at least the highest lane of `lanes`.
@@ -61,8 +35,19 @@ public:
     // own State, value-initialised, kept from step to step. A shader that runs alone keeps lane 0's only.
     template <class State, class... Steps>
     void TraceRaysInSteps(Steps&&... steps) {
-        if (runsAlone()) inSteps<State, 1>(steps...);
-        else inSteps<State, kMaxWaveWidth>(steps...);
+        if (runsAlone()) {
+            std::array<State, 1> states{};
+            inSteps(std::span<State>(states), steps...);
+        } else {
+            std::array<State, kMaxWaveWidth> states{};
+            inSteps(std::span<State>(states), steps...);
+        }
+    }
+    // The same with the lanes' states kept by the shader (states[i] lane i's; it reaches the highest active lane):
+    // for a shader whose lanes did something together before the first step (ShaderWave::CallsInLoop).
+    template <class State, class... Steps>
+    void TraceRaysInSteps(std::span<State> states, Steps&&... steps) {
+        inSteps(states, steps...);
     }
 
     // The shape of a shader with one TraceRay a launch, over the wave: each active lane runs its code up to the
@@ -84,28 +69,11 @@ public:
             });
     }
 
-    // Whether the shader runs for one lane alone (lane 0; its export's ShaderExport::function, at a wave width of 1,
-    // or where the stage's shader is called a lane at a time): a shader may then keep its lanes' state for lane 0
-    // only.
-    bool runsAlone() const { return wave_ == nullptr; }
-
-    // For the emulator, after the shader: the exception that stopped lane `lane`, if any.
-    std::exception_ptr failure(int lane) const { return failures_[size_t(lane)]; }
-
-protected:
-    // For a shader run for one lane alone (lane 0 of a wave without a Wave): rethrows what stopped the lane.
-    void rethrowAloneFailure() const {
-        if (failures_[0]) std::rethrow_exception(failures_[0]);
-    }
-
 private:
-    void fail(int lane, std::exception_ptr failure);
-
-    // TraceRaysInSteps with the state of N lanes (a wave's, or lane 0's alone).
-    template <class State, int N, class... Steps>
-    void inSteps(Steps&... steps) {
-        std::array<State, N> states{};
-        std::array<TraceRayCall, N> calls;
+    // TraceRaysInSteps with the lanes' states `states` (a wave's, or lane 0's alone).
+    template <class State, class... Steps>
+    void inSteps(std::span<State> states, Steps&... steps) {
+        std::array<TraceRayCall, kMaxWaveWidth> calls;
         size_t stepsRun = 0;
         const auto run = [&](auto& step) {
             LaneMask tracing;
@@ -116,11 +84,6 @@ private:
         };
         (run(steps), ...);
     }
-
-    std::array<ShaderContext*, kMaxWaveWidth> contexts_;
-    LaneMask active_;
-    detail::Wave* wave_;
-    std::array<std::exception_ptr, kMaxWaveWidth> failures_{};
 };
 
 }  // namespace refray::dxr

@@ -5,6 +5,7 @@
 #include <xmmintrin.h>
 
 #include <optional>
+#include <utility>
 
 #include "core/error.h"
 #include "emulator/closest_hit_wave.h"
@@ -315,6 +316,27 @@ void awaitWaveCall(ThreadState& ts, const WaveFunction& function, const WaveCall
     lane->call = nullptr;
     lane->callState = nullptr;
     rethrowFailure(*lane);
+}
+
+void runWaveCallsOfShader(Wave& wave, LaneMask lanes, const WaveCall* calls,
+                          std::array<std::exception_ptr, kMaxWaveWidth>& failures) {
+    for (int i : lanes) {
+        WaveLane& lane = wave.lanes[size_t(i)];
+        REFRAY_ASSERT(!lane.callState && !lane.failure, "lane " << i << " of a wave shader waits on a wave call");
+        lane.call = calls[size_t(i)].function;
+        lane.callKey = calls[size_t(i)].key;
+        lane.callState = calls[size_t(i)].state;
+    }
+    {
+        const MxcsrScope scheduling(wave.schedulerMxcsr);
+        runWaveCalls(wave, lanes);
+    }
+    for (int i : lanes) {
+        WaveLane& lane = wave.lanes[size_t(i)];
+        lane.call = nullptr;
+        lane.callState = nullptr;
+        failures[size_t(i)] = std::exchange(lane.failure, nullptr);
+    }
 }
 
 }  // namespace refray::dxr::detail

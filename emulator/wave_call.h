@@ -31,4 +31,12 @@ struct WaveCallKey {
     bool operator==(const WaveCallKey&) const = default;
 };
 
+// One lane's wave call, as a shader written for waves makes it for its lanes together (ShaderWave::CallInWave): what
+// ShaderContext::callInWave takes.
+struct WaveCall {
+    const WaveFunction* function = nullptr;
+    WaveCallKey key;
+    void* state = nullptr;
+};
+
 }  // namespace refray::dxr

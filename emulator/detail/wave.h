@@ -101,6 +101,12 @@ void awaitWaveCall(ThreadState& ts, const WaveFunction& function, const WaveCall
 // function's lanesPerCall lanes, in lane order.
 void runWaveCalls(Wave& wave, LaneMask lanes);
 
+// The wave calls of `lanes` made together by a shader written for waves on the wave's own stack (ShaderWave::CallInWave):
+// lane i's is calls[i]. They run as runWaveCalls runs the calls of waiting lanes, in the floating-point mode of the
+// wave's own code; what stops a lane's launch goes to failures[i].
+void runWaveCallsOfShader(Wave& wave, LaneMask lanes, const WaveCall* calls,
+                          std::array<std::exception_ptr, kMaxWaveWidth>& failures);
+
 // packet_traversal.cpp: the traversal of the rays of `lanes` (parked TraceRays).
 void traversePacket(Wave& wave, LaneMask lanes);
 

@@ -4,10 +4,12 @@
 #include "procedural/d3d12/d3d12_shaders.h"
 
 #include <cstring>
+#include <optional>
 #include <span>
 #include <type_traits>
 
 #include "emulator/closest_hit_wave.h"
+#include "emulator/compute_wave.h"
 #include "emulator/intersection_wave.h"
 #include "emulator/ray_generation_wave.h"
 #include "emulator/shader_api.h"
@@ -405,27 +407,6 @@ void runSignedDistanceCalls(std::span<void* const> lanes) {
 
 inline constexpr dxr::WaveFunction kSignedDistanceCalls{runSignedDistanceCalls, kMaxWaveWidth};
 
-template <typename T>
-PrimitiveHit<T> IntersectPrimitiveInWave(const ShaderContext& ctx, IntersectionShader shader, uint32_t primitiveType,
-                                         const math::Ray<T>& localRay, const math::RayExtent<T>& extent,
-                                         T elapsedTime, T stepScale, const Accuracy& accuracy) {
-    if constexpr (!std::is_same_v<T, float>) {
-        return IntersectPrimitive<T>(shader, primitiveType, localRay, extent, elapsedTime, stepScale, accuracy);
-    } else {
-        PrimitiveCall call;
-        call.shader = shader;
-        call.primitiveType = primitiveType;
-        call.accuracy = &accuracy;
-        call.localRay = localRay;
-        call.extent = extent;
-        call.elapsedTime = elapsedTime;
-        call.stepScale = stepScale;
-        ctx.callInWave(shader == IntersectionShader::SignedDistancePrimitive ? kSignedDistanceCalls : kPrimitiveCalls,
-                       {&accuracy, (uint64_t(shader) << 32) | primitiveType}, &call);
-        return call.result;
-    }
-}
-
 // TraceRay wrappers: both stop at MAX_RAY_RECURSION_DEPTH (black / "not in shadow"); TMin 0, TMax 10000.
 // The RayDesc and the payload are the GPU interface: the ray is rounded to float on the way in.
 // PORT: the HLSL passes the constants TraceRayParameters::InstanceMask, TraceRayParameters::HitGroup::Offset[rayType],
@@ -546,69 +527,157 @@ float committedRayT(const RayQueryObject& q, float rayTMax, InlineVariant v) {
     return q.CommittedRayT();
 }
 
-// IntersectCandidateProceduralPrimitive: the intersection shaders' code for the query's current procedural
+// The Proceed loop of the inline-tracing shaders' RayQuery objects (TraceAnyHitInline, TracePrimaryInline):
+//   while (q.Proceed()) {
+//       if (q.CandidateType() == CANDIDATE_PROCEDURAL_PRIMITIVE) {
+//           if (IntersectCandidateProceduralPrimitive(q, thit, attr)) q.CommitProceduralPrimitiveHit(thit);
+//       } else {
+//           q.CommitNonOpaqueTriangleHit();  // the primary query only
+//       }
+//   }
+// IntersectCandidateProceduralPrimitive is the intersection shaders' code for the query's current procedural
 // candidate, with the query's extent: RayTMin() -> q.RayTMin(), RayTCurrent() -> q.CommittedRayT(), RayFlags() ->
-// q.RayFlags() (a closest hit's own intrinsics describe its own ray). Returns true with t and the world normal.
-// PORT: rayTMax and the variant are for the variants only (InlineVariant); AsWritten reads neither.
+// q.RayFlags() (a closest hit's own intrinsics describe its own ray); its hit's world normal is the attribute.
+// PORT: the loop runs in steps that end at each procedural candidate's test, so that the lanes of a wave run their
+// loops together and their tests as wave calls (emulator/wave_call.h): proceed(call) runs the loop up to the next
+// procedural candidate and returns true with its test as `call` (IntersectPrimitive for the lanes that make one, in
+// float: runPrimitiveCalls, runSignedDistanceCalls), or false once Proceed returns FALSE; the next proceed commits
+// the test's hit and goes on. A shader written for waves runs its lanes' loops through ShaderWave::CallsInLoop; one
+// lane alone makes its calls through its ShaderContext (runAlone). double and PerturbedFloat test at once, for
+// withLaneType's reasons. The variant (InlineVariant) changes only the lines its comment names.
 template <typename T>
-bool IntersectCandidateProceduralPrimitive(const ShaderContext& ctx, const RayQueryObject& q, const Accuracy& accuracy,
-                                           T& thit, tvec3<T>& normal, float rayTMax = 0.0f,
-                                           InlineVariant variant = InlineVariant::AsWritten) {
-    const InlinePrimitive primitive =
-        ctx.loadStructured<InlinePrimitive>(kInlinePrimitivesRegister, 0, 0, q.CandidateGeometryIndex());
-    const PrimitiveInstancePerFrameBuffer aabbAttribute = ctx.load<PrimitiveInstancePerFrameBuffer>(
-        ctx.globalRootDescriptor(kAABBattributeBuffer) +
-        uint64_t(primitive.instanceIndex) * sizeof(PrimitiveInstancePerFrameBuffer));
-    const math::Ray<T> localRay =
-        GetRayInAABBPrimitiveLocalSpace<T>(q.CandidateObjectRayOrigin(), q.CandidateObjectRayDirection(), aabbAttribute);
-    const auto shader = IntersectionShader(primitive.intersectionShader);
-    const T elapsedTime = shader == IntersectionShader::VolumetricPrimitive ? T(sceneCB(ctx).elapsedTime) : T(0);
-    const math::RayExtent<T> extent =
-        variant == InlineVariant::NoRangeCheck
-            ? CurrentExtent<T>(-rayTMax, rayTMax, q.RayFlags())  // MUTANT: the whole line, not [RayTMin, CommittedRayT]
-            : CurrentExtent<T>(q.RayTMin(), committedRayT(q, rayTMax, variant), q.RayFlags());
-    const PrimitiveHit<T> test = IntersectPrimitiveInWave<T>(ctx, shader, primitive.primitiveType, localRay, extent,
-                                                             elapsedTime, T(primitive.stepScale), accuracy);
-    if (!test.hit) return false;
-    thit = test.thit;
-    normal = NormalToWorld(q.CandidateObjectToWorld3x4(), aabbAttribute, test.normal);
-    return true;
-}
+class InlineQueryLoop {
+public:
+    // RayQuery<templateFlags> q; q.TraceRayInline(the scene, RAY_FLAG_NONE, instanceMask, ray). `commitTriangles`:
+    // the loop commits its triangle candidates (the shadow query's are opaque, committed inside Proceed, RQ-14).
+    InlineQueryLoop(ShaderContext& ctx, uint32_t templateFlags, uint32_t instanceMask, const RayDesc& ray,
+                    bool commitTriangles, const Accuracy& accuracy, InlineVariant variant)
+        : ctx_(&ctx), q_(ctx, templateFlags, RAYQUERY_FLAG_NONE), scene_(ctx.globalRootDescriptor(kAccelerationStructure)),
+          instanceMask_(instanceMask), commitTriangles_(commitTriangles), accuracy_(&accuracy), variant_(variant) {
+        retrace(ray);
+    }
+    // The same query traced again, along `ray` (RQ-9: what the object held is discarded), as a new RayQuery of the
+    // same flags would trace it.
+    // PORT: the HLSL declares a RayQuery per call of TraceAnyHitInline; one object traced again is the same query
+    // (same checks, counts and events), made once per lane (and the scene's address read once).
+    void retrace(const RayDesc& ray) {
+        pending_ = false;
+        committedNormal_ = tvec3<T>(T(0));
+        rayTMax_ = ray.TMax;
+        q_.TraceRayInline(scene_, RAY_FLAG_NONE, instanceMask_, ray);
+    }
+    InlineQueryLoop(const InlineQueryLoop&) = delete;
+    InlineQueryLoop& operator=(const InlineQueryLoop&) = delete;
 
-// TraceAnyHitInline: true when the ray from origin along direction meets a surface in [0, tMax]. Procedural
-// candidates are intersected here and committed; the ground plane's triangles are opaque (FORCE_OPAQUE) and
+    bool proceed(WaveCall& call) {
+        if (pending_) {
+            pending_ = false;
+            if constexpr (std::is_same_v<T, float>) commitTest(call_.result);
+        }
+        while (q_.Proceed()) {
+            if (q_.CandidateType() != CANDIDATE_PROCEDURAL_PRIMITIVE) {
+                if (commitTriangles_) q_.CommitNonOpaqueTriangleHit();  // no any-hit shader: TraceRay would accept it
+                continue;
+            }
+            if (variant_ == InlineVariant::IgnoreProcedural) continue;  // LESSON: the candidate is never intersected
+            const InlinePrimitive primitive =
+                ctx_->loadStructured<InlinePrimitive>(kInlinePrimitivesRegister, 0, 0, q_.CandidateGeometryIndex());
+            aabbAttribute_ = ctx_->load<PrimitiveInstancePerFrameBuffer>(
+                ctx_->globalRootDescriptor(kAABBattributeBuffer) +
+                uint64_t(primitive.instanceIndex) * sizeof(PrimitiveInstancePerFrameBuffer));
+            const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(
+                q_.CandidateObjectRayOrigin(), q_.CandidateObjectRayDirection(), aabbAttribute_);
+            const auto shader = IntersectionShader(primitive.intersectionShader);
+            const T elapsedTime = shader == IntersectionShader::VolumetricPrimitive ? T(sceneCB(*ctx_).elapsedTime) : T(0);
+            const math::RayExtent<T> extent =
+                variant_ == InlineVariant::NoRangeCheck
+                    ? CurrentExtent<T>(-rayTMax_, rayTMax_, q_.RayFlags())  // MUTANT: the whole line
+                    : CurrentExtent<T>(q_.RayTMin(), committedRayT(q_, rayTMax_, variant_), q_.RayFlags());
+            objectToWorld_ = q_.CandidateObjectToWorld3x4();
+            if constexpr (std::is_same_v<T, float>) {
+                call_ = {shader, primitive.primitiveType, accuracy_, localRay, extent, elapsedTime, primitive.stepScale, {}};
+                call = {shader == IntersectionShader::SignedDistancePrimitive ? &kSignedDistanceCalls : &kPrimitiveCalls,
+                        {accuracy_, (uint64_t(shader) << 32) | primitive.primitiveType}, &call_};
+                pending_ = true;
+                return true;
+            } else {
+                commitTest(IntersectPrimitive<T>(shader, primitive.primitiveType, localRay, extent, elapsedTime,
+                                                 T(primitive.stepScale), *accuracy_));
+            }
+        }
+        return false;
+    }
+
+    // The whole loop for a lane alone: its tests are its ShaderContext's wave calls.
+    void runAlone() {
+        WaveCall call;
+        while (proceed(call)) ctx_->callInWave(*call.function, call.key, call.state);
+    }
+
+    const RayQueryObject& query() const { return q_; }
+    float rayTMax() const { return rayTMax_; }
+    // The world normal of the procedural hit committed last (zero before one): the system keeps no attributes of a
+    // procedural hit (RQ-23), the shader keeps them.
+    const tvec3<T>& committedNormal() const { return committedNormal_; }
+
+private:
+    // The candidate's test done: a hit is committed (ACCEPT_FIRST_HIT_AND_END_SEARCH: Proceed then returns FALSE).
+    void commitTest(const PrimitiveHit<T>& test) {
+        if (!test.hit) return;
+        const tvec3<T> normal = NormalToWorld(objectToWorld_, aabbAttribute_, test.normal);
+        q_.CommitProceduralPrimitiveHit(float(test.thit));
+        committedNormal_ = tvec3<T>(vec3(normal));  // float, as the HLSL's attribute
+    }
+
+    ShaderContext* ctx_;
+    RayQueryObject q_;
+    GpuVirtualAddress scene_;
+    uint32_t instanceMask_;
+    float rayTMax_ = 0.0f;
+    bool commitTriangles_;
+    const Accuracy* accuracy_;
+    InlineVariant variant_;
+    bool pending_ = false;
+    PrimitiveCall call_;  // the pending test's (float)
+    PrimitiveInstancePerFrameBuffer aabbAttribute_{};
+    Matrix3x4 objectToWorld_{};
+    tvec3<T> committedNormal_{T(0)};
+};
+
+// TraceAnyHitInline's query: true when the ray from origin along direction meets a surface in [0, tMax]. Procedural
+// candidates are intersected in the loop and committed; the ground plane's triangles are opaque (FORCE_OPAQUE) and
 // committed inside Proceed (RQ-14). The shadow rays' query, which the AO occlusion rays trace too.
 // PORT: RayQuery<kInlineShadowQueryFlags> q; the object is made with the variant's template flags
 // (inlineShadowQueryFlags), which for AsWritten are kInlineShadowQueryFlags.
 // PORT: TraceRayParameters::InstanceMask is the library's shadow-ray mask, as in the TraceRay version.
+// PORT: a lane's next query (`loop` already made: its next occlusion ray) traces the same object again (retrace).
 template <typename T>
-bool TraceAnyHitInline(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                       const tvec3<T>& origin, const tvec3<T>& direction, float tMax, InlineVariant variant) {
+void AnyHitQuery(std::optional<InlineQueryLoop<T>>& loop, ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
+                 const Accuracy& accuracy, const tvec3<T>& origin, const tvec3<T>& direction, float tMax,
+                 InlineVariant variant) {
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), tMax};
-    RayQueryObject q(ctx, inlineShadowQueryFlags(variant), RAYQUERY_FLAG_NONE);
-    q.TraceRayInline(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_NONE,
-                     traceRay[RayType::Shadow].instanceInclusionMask, rayDesc);
-    while (q.Proceed()) {
-        if (q.CandidateType() == CANDIDATE_PROCEDURAL_PRIMITIVE) {
-            if (variant == InlineVariant::IgnoreProcedural) continue;  // LESSON: the candidate is never intersected
-            T thit;
-            tvec3<T> normal;
-            if (IntersectCandidateProceduralPrimitive<T>(ctx, q, accuracy, thit, normal, rayDesc.TMax, variant))
-                q.CommitProceduralPrimitiveHit(float(thit));  // ACCEPT_FIRST_HIT_AND_END_SEARCH: Proceed returns FALSE
-        }
-    }
-    return q.CommittedStatus() != COMMITTED_NOTHING;
+    if (loop) return loop->retrace(rayDesc);  // a lane's next shadow or occlusion query
+    loop.emplace(ctx, inlineShadowQueryFlags(variant), traceRay[RayType::Shadow].instanceInclusionMask, rayDesc,
+                 /*commitTriangles*/ false, accuracy, variant);
 }
 
-// TraceShadowRayAndReportIfHit, traced inline: TMax 10000, as the TraceRay version.
+// TraceAnyHitInline's result, after its loop.
 template <typename T>
-bool TraceShadowRayInlineAndReportIfHit(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint32_t maxDepth,
-                                        const Effects& effects, const Accuracy& accuracy, const tvec3<T>& origin,
-                                        const tvec3<T>& direction, uint32_t currentRayRecursionDepth,
-                                        InlineVariant variant = InlineVariant::AsWritten) {
+bool AnyHitQueryResult(const InlineQueryLoop<T>& loop) {
+    return loop.query().CommittedStatus() != COMMITTED_NOTHING;
+}
+
+// TraceShadowRayAndReportIfHit, traced inline (TraceShadowRayInlineAndReportIfHit) up to its query: false where the
+// HLSL returns false untraced (at MAX_RAY_RECURSION_DEPTH, or with shadows switched off); else true with the query
+// TraceAnyHitInline makes, TMax 10000 as the TraceRay version. The function's result is then AnyHitQueryResult.
+template <typename T>
+bool ShadowQueryInline(std::optional<InlineQueryLoop<T>>& loop, ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
+                       uint32_t maxDepth, const Effects& effects, const Accuracy& accuracy, const tvec3<T>& origin,
+                       const tvec3<T>& direction, uint32_t currentRayRecursionDepth, InlineVariant variant) {
     if (currentRayRecursionDepth >= maxDepth) return false;
     if (!kShadowMachinery || !effects.traceShadowRays) return false;  // PORT: shadows switched off (procedural/effects.h)
-    return TraceAnyHitInline(ctx, traceRay, accuracy, origin, direction, 10000.0f, variant);
+    AnyHitQuery(loop, ctx, traceRay, accuracy, origin, direction, 10000.0f, variant);
+    return true;
 }
 
 // How a closest hit traces its shadow ray: TraceRay (the sample) or a RayQuery (InlineShadows.hlsl).
@@ -624,13 +693,14 @@ tvec4<T> ReflectedColor(const tvec3<T>& D, const tvec3<T>& normal, const Primiti
 }
 
 // What a closest hit's lane carries from one TraceRay to the next: its constants, its normal, its shadow ray's
-// payload and result, and its reflection ray's.
+// origin, direction, payload and result, and its reflection ray's.
 template <typename T>
 struct ClosestHitLane {
     SceneConstantBuffer sceneCB;
     PrimitiveConstantBuffer materialCB;
     tvec3<T> normal;
     T checkers = T(1);
+    tvec3<T> hitPosition, toLight;
     ShadowRayPayload shadowPayload;
     bool shadowTraced = false;
     bool shadowRayHit = false;
@@ -643,56 +713,77 @@ struct ClosestHitLane {
 // `open(ctx, lane, attr)` reads a lane's normal; its shadow ray from HitWorldPosition() towards the light
 // (TraceShadowRayAndReportIfHit, or traced inline); `beforeReflection(ctx, lane)` (the triangle's checkers); its
 // reflected component, reflectanceCoef > 0.001 (ReflectedColor: a reflection ray); its Phong colour, `combine(lane,
-// phongColor, reflectedColor)`, and the visibility falloff. The lanes' shadow rays go out together, then their
-// reflection rays (TracingWave::TraceRaysInSteps).
+// phongColor, reflectedColor)`, and the visibility falloff. The lanes' shadow rays go out together (TraceRay), or
+// their inline queries' loops run together (ShaderWave::CallsInLoop); then their reflection rays
+// (TracingWave::TraceRaysInSteps).
 template <typename T, class Attributes, class Open, class BeforeReflection, class Combine>
 void SampleClosestHit(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
                       const Effects& effects, ShadowTracing tracing, InlineVariant variant, Open open,
                       BeforeReflection beforeReflection, Combine combine) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
-    wave.TraceRaysInSteps<ClosestHitLane<T>>(
-        // Shadow component.
-        [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall& call) {
-            const uint32_t recursionDepth = wave.payload<RayPayload>(i).recursionDepth;
-            l.sceneCB = sceneCB(ctx);
-            l.materialCB = materialCB(ctx);
-            open(ctx, l, wave.attributes<Attributes>(i));
-            const tvec3<T> hitPosition = HitWorldPosition<T>(ctx);
-            const tvec3<T> toLight = hlsl::normalize(tvec3<T>(vec3(l.sceneCB.lightPosition)) - hitPosition);
-            if (tracing == ShadowTracing::TraceRay)
-                return l.shadowTraced = ShadowRayCall(ctx, traceRay, maxDepth, effects, hitPosition, toLight,
-                                                      recursionDepth, l.shadowPayload, call);
-            l.shadowRayHit = TraceShadowRayInlineAndReportIfHit(ctx, traceRay, maxDepth, effects, accuracy, hitPosition,
-                                                                toLight, recursionDepth, variant);
-            return false;
-        },
-        // Reflected component: the ray of ReflectedColor, when reflectanceCoef > 0.001.
-        [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall& call) {
-            if (l.shadowTraced) l.shadowRayHit = l.shadowPayload.hit != 0;  // TraceShadowRayAndReportIfHit's result
-            beforeReflection(ctx, l);
-            if (!(l.materialCB.reflectanceCoef > 0.001f)) return false;
-            l.D = tvec3<T>(ctx.WorldRayDirection());
-            return l.reflected = RadianceRayCall(ctx, traceRay, maxDepth, HitWorldPosition<T>(ctx),
-                                                 hlsl::reflect(l.D, l.normal), wave.payload<RayPayload>(i).recursionDepth,
-                                                 l.reflectionPayload, call);
-        },
-        // Final colour, then the visibility falloff.
-        [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall&) {
-            tvec4<T> reflectedColor(T(0));
-            if (l.materialCB.reflectanceCoef > 0.001f) {
-                // TraceRadianceRay's colour: black where RadianceRayCall made no ray (MAX_RAY_RECURSION_DEPTH).
-                const tvec4<T> reflectionColor = l.reflected ? tvec4<T>(l.reflectionPayload.color) : tvec4<T>(T(0));
-                reflectedColor = ReflectedColor(l.D, l.normal, l.materialCB, reflectionColor);
-            }
-            const tvec4<T> phongColor = CalculatePhongLighting(
-                l.sceneCB, tvec4<T>(l.materialCB.albedo), l.normal, l.shadowRayHit, T(l.materialCB.diffuseCoef),
-                T(l.materialCB.specularCoef), T(l.materialCB.specularPower), HitWorldPosition<T>(ctx),
-                tvec3<T>(ctx.WorldRayDirection()));
-            const tvec4<T> color = combine(l, phongColor, reflectedColor);
-            wave.payload<RayPayload>(i).color = vec4(ApplyVisibilityFalloff(color, T(ctx.RayTCurrent())));
-            return false;
-        });
+    std::array<ClosestHitLane<T>, kMaxWaveWidth> lanes;
+    // Up to the shadow ray: the lane's constants, normal, hit position and the direction to the light.
+    const auto openLane = [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l) {
+        l.sceneCB = sceneCB(ctx);
+        l.materialCB = materialCB(ctx);
+        open(ctx, l, wave.attributes<Attributes>(i));
+        l.hitPosition = HitWorldPosition<T>(ctx);
+        l.toLight = hlsl::normalize(tvec3<T>(vec3(l.sceneCB.lightPosition)) - l.hitPosition);
+    };
+    // Shadow component, traced by TraceRay.
+    const auto shadowRay = [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall& call) {
+        openLane(i, ctx, l);
+        return l.shadowTraced = ShadowRayCall(ctx, traceRay, maxDepth, effects, l.hitPosition, l.toLight,
+                                              wave.payload<RayPayload>(i).recursionDepth, l.shadowPayload, call);
+    };
+    // Reflected component: the ray of ReflectedColor, when reflectanceCoef > 0.001.
+    const auto reflectionRay = [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall& call) {
+        if (l.shadowTraced) l.shadowRayHit = l.shadowPayload.hit != 0;  // TraceShadowRayAndReportIfHit's result
+        beforeReflection(ctx, l);
+        if (!(l.materialCB.reflectanceCoef > 0.001f)) return false;
+        l.D = tvec3<T>(ctx.WorldRayDirection());
+        return l.reflected = RadianceRayCall(ctx, traceRay, maxDepth, l.hitPosition, hlsl::reflect(l.D, l.normal),
+                                             wave.payload<RayPayload>(i).recursionDepth, l.reflectionPayload, call);
+    };
+    // Final colour, then the visibility falloff.
+    const auto finalColor = [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall&) {
+        tvec4<T> reflectedColor(T(0));
+        if (l.materialCB.reflectanceCoef > 0.001f) {
+            // TraceRadianceRay's colour: black where RadianceRayCall made no ray (MAX_RAY_RECURSION_DEPTH).
+            const tvec4<T> reflectionColor = l.reflected ? tvec4<T>(l.reflectionPayload.color) : tvec4<T>(T(0));
+            reflectedColor = ReflectedColor(l.D, l.normal, l.materialCB, reflectionColor);
+        }
+        const tvec4<T> phongColor = CalculatePhongLighting(
+            l.sceneCB, tvec4<T>(l.materialCB.albedo), l.normal, l.shadowRayHit, T(l.materialCB.diffuseCoef),
+            T(l.materialCB.specularCoef), T(l.materialCB.specularPower), l.hitPosition,
+            tvec3<T>(ctx.WorldRayDirection()));
+        const tvec4<T> color = combine(l, phongColor, reflectedColor);
+        wave.payload<RayPayload>(i).color = vec4(ApplyVisibilityFalloff(color, T(ctx.RayTCurrent())));
+        return false;
+    };
+    if (tracing == ShadowTracing::TraceRay) {
+        wave.TraceRaysInSteps(std::span<ClosestHitLane<T>>(lanes), shadowRay, reflectionRay, finalColor);
+        return;
+    }
+    // Shadow component, traced inline: the lanes' queries' loops together.
+    std::array<std::optional<InlineQueryLoop<T>>, kMaxWaveWidth> shadowQueries;
+    LaneMask querying;
+    wave.forEachLane([&](int i, ShaderContext& ctx) {
+        ClosestHitLane<T>& l = lanes[size_t(i)];
+        openLane(i, ctx, l);
+        if (ShadowQueryInline(shadowQueries[size_t(i)], ctx, traceRay, maxDepth, effects, accuracy, l.hitPosition, l.toLight,
+                              wave.payload<RayPayload>(i).recursionDepth, variant))
+            querying.set(i);
+    });
+    wave.CallsInLoop(querying, [&](int i, ShaderContext&, WaveCall& call) {
+        return shadowQueries[size_t(i)]->proceed(call);
+    });
+    wave.forEachLane([&](int i, ShaderContext&) {
+        ClosestHitLane<T>& l = lanes[size_t(i)];
+        if (querying.test(i)) l.shadowRayHit = AnyHitQueryResult(*shadowQueries[size_t(i)]);
+    });
+    wave.TraceRaysInSteps(std::span<ClosestHitLane<T>>(lanes), reflectionRay, finalColor);
 }
 
 // ---- Entry points ----------------------------------------------------------------------------------
@@ -789,38 +880,30 @@ tvec3<T> CosineHemisphereDirection(const tvec3<T>& n, T u1, T u2) {
     return r * hlsl::cos(phi) * t1 + r * hlsl::sin(phi) * t2 + hlsl::sqrt(T(1) - u1) * n;
 }
 
-// The primary query: the closest surface and its world normal, as the sample's closest hits compute it. The system
-// keeps no attributes of a procedural hit (RQ-23): the shader keeps the normal of the hit it commits.
+// The primary query (TracePrimaryInline): the closest surface and its world normal, as the sample's closest hits
+// compute it. The system keeps no attributes of a procedural hit (RQ-23): the loop keeps the normal of the hit it
+// commits.
 template <typename T>
-bool TracePrimaryInline(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                        const tvec3<T>& origin, const tvec3<T>& direction, tvec3<T>& hitPosition, tvec3<T>& normal,
-                        InlineVariant variant = InlineVariant::AsWritten) {
+void PrimaryQuery(std::optional<InlineQueryLoop<T>>& loop, ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
+                  const Accuracy& accuracy, const tvec3<T>& origin, const tvec3<T>& direction, InlineVariant variant) {
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
-    tvec3<T> committedNormal(T(0));
-    RayQuery<kInlinePrimaryQueryFlags> q(ctx);
-    q.TraceRayInline(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_NONE,
-                     traceRay[RayType::Radiance].instanceInclusionMask, rayDesc);
-    while (q.Proceed()) {
-        if (q.CandidateType() == CANDIDATE_PROCEDURAL_PRIMITIVE) {
-            if (variant == InlineVariant::IgnoreProcedural) continue;  // LESSON: the candidate is never intersected
-            T thit;
-            tvec3<T> candidateNormal;
-            if (IntersectCandidateProceduralPrimitive<T>(ctx, q, accuracy, thit, candidateNormal, rayDesc.TMax,
-                                                         variant)) {
-                q.CommitProceduralPrimitiveHit(float(thit));
-                committedNormal = tvec3<T>(vec3(candidateNormal));  // float, as the HLSL's attribute
-            }
-        } else {
-            q.CommitNonOpaqueTriangleHit();  // no any-hit shader in the sample: TraceRay would accept it
-        }
-    }
+    static_assert(rayQueryTemplateError(kInlinePrimaryQueryFlags, RAYQUERY_FLAG_NONE) == nullptr);
+    loop.emplace(ctx, kInlinePrimaryQueryFlags, traceRay[RayType::Radiance].instanceInclusionMask, rayDesc,
+                 /*commitTriangles*/ true, accuracy, variant);
+}
+
+// TracePrimaryInline's result, after its loop: whether it hit, with the hit's position and normal.
+template <typename T>
+bool PrimaryQueryResult(ShaderContext& ctx, const InlineQueryLoop<T>& loop, const tvec3<T>& origin,
+                        const tvec3<T>& direction, tvec3<T>& hitPosition, tvec3<T>& normal, InlineVariant variant) {
+    const RayQueryObject& q = loop.query();
     hitPosition = tvec3<T>(T(0));
     normal = tvec3<T>(T(0));
     uint32_t status = q.CommittedStatus();
     if (variant == InlineVariant::ReadCommittedAfterMiss)  // LESSON: the instance (0: the ground) before the status
         status = q.CommittedInstanceIndex() == 0 ? COMMITTED_TRIANGLE_HIT : status;
     if (status == COMMITTED_NOTHING) return false;
-    hitPosition = origin + T(committedRayT(q, rayDesc.TMax, variant)) * direction;
+    hitPosition = origin + T(committedRayT(q, loop.rayTMax(), variant)) * direction;
     if (status == COMMITTED_TRIANGLE_HIT) {
         // MyClosestHitShader_Triangle's normal: the first vertex's, untransformed.
         const uint32_t baseIndex = q.CommittedPrimitiveIndex() * 6;
@@ -830,50 +913,90 @@ bool TracePrimaryInline(ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
         normal = tvec3<T>(
             ctx.loadFromTable<Vertex>(vertexBuffers, /*g_vertices*/ 1, uint64_t(indices[0]) * sizeof(Vertex)).normal);
     } else {
-        normal = committedNormal;
+        normal = loop.committedNormal();
     }
     return true;
 }
 
-// True when the occlusion ray meets any surface within AO_RADIUS: the shadow rays' query.
+// TraceOcclusionInline's query: the occlusion ray `ray` (0 .. AO_RAY_COUNT-1) of the pixel whose hash is `seed`,
+// from `hitPosition` around `normal`; it meets a surface when any lies within AO_RADIUS: the shadow rays' query.
 template <typename T>
-bool TraceOcclusionInline(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
-                          const tvec3<T>& origin, const tvec3<T>& direction,
-                          InlineVariant variant = InlineVariant::AsWritten) {
-    return TraceAnyHitInline(ctx, traceRay, accuracy, origin, direction, AO_RADIUS, variant);
+void OcclusionQuery(std::optional<InlineQueryLoop<T>>& loop, ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
+                    const Accuracy& accuracy, uint32_t seed, uint32_t ray, const tvec3<T>& hitPosition,
+                    const tvec3<T>& normal, InlineVariant variant) {
+    const T u1 = T(UnitFloat(Hash(seed ^ (2 * ray))));
+    const T u2 = T(UnitFloat(Hash(seed ^ (2 * ray + 1))));
+    const tvec3<T> direction = CosineHemisphereDirection(normal, u1, u2);
+    AnyHitQuery(loop, ctx, traceRay, accuracy, hitPosition + T(AO_ORIGIN_OFFSET) * normal, direction, AO_RADIUS,
+                variant);
 }
 
 // [numthreads(8, 8, 1)] InlineAmbientOcclusionCS: one thread per pixel; threads past the render target's edge return.
+//   if (TracePrimaryInline(origin, rayDir, hitPosition, normal)) {
+//       seed = Hash(id.x ^ Hash(id.y)); escaped = 0;
+//       for (i = 0; i < AO_RAY_COUNT; ++i) if (!TraceOcclusionInline(...ray i...)) escaped++;
+//       color = float4(ao, ao, ao, 1) with ao = escaped / AO_RAY_COUNT;
+//   }
+// PORT: written for waves (emulator/compute_wave.h): each lane's code up to its primary query's loop, the lanes'
+// loops together (ComputeWave::CallsInLoop, InlineQueryLoop), each lane's result; then each lane's occlusion rays,
+// one after another in the lane, their loops together; then each lane's colour.
 template <typename T>
-void InlineAmbientOcclusionCS(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
+void InlineAmbientOcclusionCS(ComputeWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
                               InlineVariant variant) {
     [[maybe_unused]] PrecisionScope<T> scope;
-    const uvec3 id = ctx.DispatchThreadID();
-    Image& target = ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView));
-    const uint32_t width = target.width(), height = target.height();  // g_renderTarget.GetDimensions
-    if (id.x >= width || id.y >= height) return;
-
-    const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
-    tvec3<T> origin, rayDir;
-    GenerateCameraRay(uvec2(id), uvec2(width, height), tvec3<T>(vec3(g_sceneCB.cameraPosition)),
-                      g_sceneCB.projectionToWorld, origin, rayDir);
-    tvec3<T> hitPosition, normal;
-    tvec4<T> color = tvec4<T>(BackgroundColor);
-    if (TracePrimaryInline<T>(ctx, traceRay, accuracy, origin, rayDir, hitPosition, normal, variant)) {
-        const uint32_t seed = Hash(id.x ^ Hash(id.y));
-        uint32_t escaped = 0;
-        for (uint32_t i = 0; i < AO_RAY_COUNT; ++i) {
-            const T u1 = T(UnitFloat(Hash(seed ^ (2 * i))));
-            const T u2 = T(UnitFloat(Hash(seed ^ (2 * i + 1))));
-            const tvec3<T> direction = CosineHemisphereDirection(normal, u1, u2);
-            if (!TraceOcclusionInline<T>(ctx, traceRay, accuracy, hitPosition + T(AO_ORIGIN_OFFSET) * normal, direction,
-                                         variant))
-                escaped++;
+    struct Lane {
+        Image* target = nullptr;
+        uvec2 id{0u};
+        tvec3<T> origin, rayDir, hitPosition, normal;
+        std::optional<InlineQueryLoop<T>> primary, occlusion;
+        uint32_t seed = 0, ray = 0, escaped = 0;
+        bool hit = false;
+    };
+    std::array<Lane, kMaxWaveWidth> lanes;
+    LaneMask inside;  // threads inside the render target
+    wave.forEachLane([&](int i, ShaderContext& ctx) {
+        Lane& l = lanes[size_t(i)];
+        const uvec3 id = ctx.DispatchThreadID();
+        l.target = &ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView));
+        const uint32_t width = l.target->width(), height = l.target->height();  // g_renderTarget.GetDimensions
+        if (id.x >= width || id.y >= height) return;
+        l.id = uvec2(id);
+        const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
+        GenerateCameraRay(l.id, uvec2(width, height), tvec3<T>(vec3(g_sceneCB.cameraPosition)),
+                          g_sceneCB.projectionToWorld, l.origin, l.rayDir);
+        PrimaryQuery(l.primary, ctx, traceRay, accuracy, l.origin, l.rayDir, variant);
+        inside.set(i);
+    });
+    wave.CallsInLoop(inside, [&](int i, ShaderContext&, WaveCall& call) { return lanes[size_t(i)].primary->proceed(call); });
+    LaneMask occluded;  // lanes whose primary ray hit: they trace occlusion rays
+    wave.forEachLane([&](int i, ShaderContext& ctx) {
+        Lane& l = lanes[size_t(i)];
+        if (!inside.test(i)) return;
+        l.hit = PrimaryQueryResult(ctx, *l.primary, l.origin, l.rayDir, l.hitPosition, l.normal, variant);
+        if (!l.hit) return;
+        l.seed = Hash(l.id.x ^ Hash(l.id.y));
+        OcclusionQuery(l.occlusion, ctx, traceRay, accuracy, l.seed, 0, l.hitPosition, l.normal, variant);
+        occluded.set(i);
+    });
+    wave.CallsInLoop(occluded, [&](int i, ShaderContext& ctx, WaveCall& call) {
+        Lane& l = lanes[size_t(i)];
+        while (!l.occlusion->proceed(call)) {  // the lane's occlusion ray l.ray is over
+            if (!AnyHitQueryResult(*l.occlusion)) l.escaped++;
+            if (++l.ray == AO_RAY_COUNT) return false;
+            OcclusionQuery(l.occlusion, ctx, traceRay, accuracy, l.seed, l.ray, l.hitPosition, l.normal, variant);
         }
-        const T ao = T(escaped) / T(AO_RAY_COUNT);
-        color = tvec4<T>(ao, ao, ao, T(1));
-    }
-    target.at(id.x, id.y) = vec4(color);
+        return true;
+    });
+    wave.forEachLane([&](int i, ShaderContext&) {
+        const Lane& l = lanes[size_t(i)];
+        if (!inside.test(i)) return;
+        tvec4<T> color = tvec4<T>(BackgroundColor);
+        if (l.hit) {
+            const T ao = T(l.escaped) / T(AO_RAY_COUNT);
+            color = tvec4<T>(ao, ao, ao, T(1));
+        }
+        l.target->at(l.id.x, l.id.y) = vec4(color);
+    });
 }
 
 // Each intersection shader starts from zero-initialised attributes (H6) and reports HitKind 0 with the world normal.
@@ -953,14 +1076,7 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
     // would make one lane at a time.
     const auto addClosestHits = [&](const std::string& suffix, ShadowTracing tracing, InlineVariant variant) {
         const auto add = [&]<class Attributes>(const std::string& name, WaveClosestHitShader shader) {
-            if (tracing == ShadowTracing::TraceRay) {
-                lib.addWaveClosestHit<RayPayload, Attributes>(name, std::move(shader));
-                return;
-            }
-            lib.addClosestHit<RayPayload, Attributes>(
-                name, [shader](ShaderContext& ctx, RayPayload& payload, const Attributes& attr) {
-                    ClosestHitWave::runAlone(shader, ctx, &payload, &attr);
-                });
+            lib.addWaveClosestHit<RayPayload, Attributes>(name, std::move(shader));
         };
         add.template operator()<BuiltInTriangleIntersectionAttributes>(
             "MyClosestHitShader_Triangle" + suffix,
@@ -977,9 +1093,9 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
     addClosestHits("_InlineShadow", ShadowTracing::Inline, InlineVariant::AsWritten);
     lib.declareRayQueries("MyClosestHitShader_Triangle_InlineShadow", {kInlineShadowQueryFlags});
     lib.declareRayQueries("MyClosestHitShader_AABB_InlineShadow", {kInlineShadowQueryFlags});
-    lib.addCompute("InlineAmbientOcclusionCS", uvec3(8, 8, 1), in([traceRay, accuracy](ShaderContext& ctx) {
-                       InlineAmbientOcclusionCS<T>(ctx, traceRay, accuracy, InlineVariant::AsWritten);
-                   }));
+    lib.addWaveCompute("InlineAmbientOcclusionCS", uvec3(8, 8, 1), in([traceRay, accuracy](ComputeWave& wave) {
+                           InlineAmbientOcclusionCS<T>(wave, traceRay, accuracy, InlineVariant::AsWritten);
+                       }));
     lib.declareRayQueries("InlineAmbientOcclusionCS", {kInlinePrimaryQueryFlags, kInlineShadowQueryFlags});
     // The variants of the inline-tracing exports (InlineVariant): <export>_<variant>, for the lessons and mutants.
     for (const InlineVariant variant : kInlineVariants) {
@@ -989,9 +1105,9 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
         lib.declareRayQueries("MyClosestHitShader_Triangle" + suffix, {inlineShadowQueryFlags(variant)});
         lib.declareRayQueries("MyClosestHitShader_AABB" + suffix, {inlineShadowQueryFlags(variant)});
         const std::string cs = "InlineAmbientOcclusionCS" + inlineVariantSuffix(variant);
-        lib.addCompute(cs, uvec3(8, 8, 1), in([traceRay, accuracy, variant](ShaderContext& ctx) {
-                           InlineAmbientOcclusionCS<T>(ctx, traceRay, accuracy, variant);
-                       }));
+        lib.addWaveCompute(cs, uvec3(8, 8, 1), in([traceRay, accuracy, variant](ComputeWave& wave) {
+                               InlineAmbientOcclusionCS<T>(wave, traceRay, accuracy, variant);
+                           }));
         lib.declareRayQueries(cs, {kInlinePrimaryQueryFlags, inlineShadowQueryFlags(variant)});
     }
     lib.addMiss<RayPayload>("MyMissShader", MyMissShader);
