@@ -119,24 +119,10 @@ void gatherAlone(ThreadState& ts, RayState& rs, const Site& site, std::vector<Ca
 
 }  // namespace
 
-void gatherOrderedCandidates(std::span<GatherRay> rays) {
-    // Rays that take FirstHit go alone (their candidates are processed inside the traversal); the others traverse
-    // in packets of the rays that share a TLAS, in the order of their lanes.
-    std::array<bool, kMaxWaveWidth> pending{};
-    for (size_t i = 0; i < rays.size(); ++i) {
-        GatherRay& ray = rays[i];
-        const GatherMode mode = traversalMode(*ray.ts, *ray.rs);
-        if (mode != GatherMode::FirstHit) {
-            prepare(ray, ray.ts->candidates, mode);
-            pending[i] = true;
-            continue;
-        }
-        try {
-            gatherAlone(*ray.ts, *ray.rs, *ray.site, ray.ts->candidates, mode);
-        } catch (...) {
-            ray.error = std::current_exception();
-        }
-    }
+namespace {
+
+// The rays of `rays` marked `pending` (their requests prepared), in packets of the rays that share a TLAS, in order.
+void gatherInPackets(std::span<GatherRay> rays, std::array<bool, kMaxWaveWidth>& pending) {
     for (size_t first = 0; first < rays.size(); ++first) {
         if (!pending[first]) continue;
         std::array<const GatherRequest*, kMaxGatherPacket> requests{};
@@ -158,8 +144,40 @@ void gatherOrderedCandidates(std::span<GatherRay> rays) {
     }
 }
 
+}  // namespace
+
+void gatherOrderedCandidates(std::span<GatherRay> rays) {
+    // Rays that take FirstHit go alone (their candidates are processed inside the traversal); the others traverse
+    // in packets of the rays that share a TLAS, in the order of their lanes.
+    std::array<bool, kMaxWaveWidth> pending{};
+    for (size_t i = 0; i < rays.size(); ++i) {
+        GatherRay& ray = rays[i];
+        const GatherMode mode = traversalMode(*ray.ts, *ray.rs);
+        if (mode != GatherMode::FirstHit) {
+            prepare(ray, ray.ts->candidates, mode);
+            pending[i] = true;
+            continue;
+        }
+        try {
+            gatherAlone(*ray.ts, *ray.rs, *ray.site, ray.ts->candidates, mode);
+        } catch (...) {
+            ray.error = std::current_exception();
+        }
+    }
+    gatherInPackets(rays, pending);
+}
+
 void gatherQueryCandidates(ThreadState& ts, RayState& rs, const Site& site, std::vector<Candidate>& out) {
     gatherAlone(ts, rs, site, out, GatherMode::All);
+}
+
+void gatherQueryCandidatesPacket(std::span<GatherRay> rays, std::span<std::vector<Candidate>* const> outs) {
+    std::array<bool, kMaxWaveWidth> pending{};
+    for (size_t i = 0; i < rays.size(); ++i) {
+        prepare(rays[i], *outs[i], GatherMode::All);
+        pending[i] = true;
+    }
+    gatherInPackets(rays, pending);
 }
 
 }  // namespace refray::dxr::detail

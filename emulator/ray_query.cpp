@@ -7,12 +7,14 @@
 #include <string>
 #include <vector>
 
+#include "core/error.h"
 #include "emulator/detail/candidate_gathering.h"
 #include "emulator/detail/candidate_rules.h"
 #include "emulator/detail/dispatch_errors.h"
 #include "emulator/detail/thread_state.h"
 #include "emulator/detail/trace_events.h"
 #include "emulator/detail/trace_ray.h"
+#include "emulator/lane_mask.h"
 #include "emulator/shader_api.h"
 
 namespace refray::dxr {
@@ -244,6 +246,12 @@ RayQueryObject::RayQueryObject(ShaderContext& ctx, uint32_t templateRayFlags, ui
 }
 
 void RayQueryObject::TraceRayInline(GpuVirtualAddress as, uint32_t rayFlags, uint32_t mask, const RayDesc& ray) {
+    if (!initialise(as, rayFlags, mask, ray)) return;
+    RayQueryState& q = *state_;
+    detail::gatherQueryCandidates(detail::threadOf(q), q.rs, detail::siteOf(*q.inv), q.candidates);
+}
+
+bool RayQueryObject::initialise(GpuVirtualAddress as, uint32_t rayFlags, uint32_t mask, const RayDesc& ray) {
     RayQueryState& q = *state_;
     detail::requireLive(q, "TraceRayInline");
     detail::ThreadState& ts = detail::threadOf(q);
@@ -293,14 +301,52 @@ void RayQueryObject::TraceRayInline(GpuVirtualAddress as, uint32_t rayFlags, uin
     }
 
     // RQ-5 on the OR'd flags, RQ-11 on the ray: an invalid query finds nothing.
-    if (!detail::validateFlags(ts, site, rayFlags, q.templateFlags & kDefinedRayFlags, "RQ-5")) return;
+    if (!detail::validateFlags(ts, site, rayFlags, q.templateFlags & kDefinedRayFlags, "RQ-5")) return false;
     bool rayOk = true;
     detail::validateRay(ts, site, ray, rayOk, "RQ-11");
-    if (!rayOk || as == 0 || !detail::inTraversalRange(ray)) return;  // RQ-10: a null AS is a miss
+    if (!rayOk || as == 0 || !detail::inTraversalRange(ray)) return false;  // RQ-10: a null AS is a miss
     q.rs.tlas = detail::findTopLevelAS(ts, site, as);
-    if (!q.rs.tlas) return;
-    detail::gatherQueryCandidates(ts, q.rs, site, q.candidates);
+    return q.rs.tlas != nullptr;
 }
+
+namespace detail {
+
+void runTraceRayInlineCalls(std::span<void* const> lanes) {
+    REFRAY_ASSERT(lanes.size() <= size_t(kMaxWaveWidth), "a TraceRayInline call of " << lanes.size() << " lanes");
+    std::array<GatherRay, kMaxWaveWidth> rays;
+    std::array<std::vector<Candidate>*, kMaxWaveWidth> outs{};
+    std::array<Site, kMaxWaveWidth> sites;
+    std::array<RayQueryTraceCall*, kMaxWaveWidth> of{};  // the call of each gathered ray
+    size_t count = 0;
+    for (void* lane : lanes) {
+        RayQueryTraceCall& call = *static_cast<RayQueryTraceCall*>(lane);
+        call.failure = nullptr;
+        try {
+            if (!call.query->initialise(call.accelerationStructure, call.rayFlags, call.instanceInclusionMask,
+                                        call.ray))
+                continue;
+        } catch (...) {
+            call.failure = std::current_exception();
+            continue;
+        }
+        RayQueryState& q = *call.query->state_;
+        sites[count] = siteOf(*q.inv);
+        rays[count] = GatherRay{&threadOf(q), &q.rs, &sites[count], {}, nullptr};
+        outs[count] = &q.candidates;
+        of[count++] = &call;
+    }
+    gatherQueryCandidatesPacket(std::span(rays.data(), count), std::span(outs.data(), count));
+    for (size_t r = 0; r < count; ++r)
+        if (rays[r].error) of[r]->failure = rays[r].error;
+}
+
+}  // namespace detail
+
+namespace {
+constexpr WaveFunction kTraceRayInlineCalls{detail::runTraceRayInlineCalls, kMaxWaveWidth};
+}  // namespace
+
+WaveCall traceRayInlineCall(RayQueryTraceCall& state) { return WaveCall{&kTraceRayInlineCalls, {}, &state}; }
 
 bool RayQueryObject::Proceed() {
     RayQueryState& q = *state_;

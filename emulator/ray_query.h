@@ -17,10 +17,13 @@
 
 #include <array>
 #include <cstdint>
+#include <exception>
 #include <memory>
+#include <span>
 
 #include "core/math.h"
 #include "emulator/types.h"
+#include "emulator/wave_call.h"
 
 namespace refray::dxr {
 
@@ -57,6 +60,28 @@ constexpr const char* rayQueryTemplateError(uint32_t rayFlags, uint32_t rayQuery
 
 namespace detail {
 struct RayQueryState;  // ray_query.cpp
+}
+class RayQueryObject;
+
+// A TraceRayInline handed to the wave as a wave call (emulator/wave_call.h: traceRayInlineCall), so that the queries
+// of a wave's lanes trace together: their rays' candidates are gathered in Embree packets. Each lane's TraceRayInline
+// is the one RayQueryObject::TraceRayInline makes (its checks, diagnostics, counts, events and candidates); what
+// stops the lane's launch in it is kept in `failure`, for the lane to rethrow when the call returns.
+struct RayQueryTraceCall {
+    RayQueryObject* query = nullptr;
+    GpuVirtualAddress accelerationStructure = 0;
+    uint32_t rayFlags = 0;
+    uint32_t instanceInclusionMask = 0xFF;
+    RayDesc ray;
+    std::exception_ptr failure;
+};
+
+// The wave call of `state` (ShaderContext::callInWave, ShaderWave::CallInWave): the calls of a wave's lanes run
+// together, whatever their queries and acceleration structures.
+WaveCall traceRayInlineCall(RayQueryTraceCall& state);
+
+namespace detail {
+void runTraceRayInlineCalls(std::span<void* const> lanes);
 }
 
 // The object behind RayQuery<...>: a handle. Copies refer to the same state machine (RQ-7), as an HLSL assignment
@@ -128,6 +153,10 @@ public:
     bool sameQueryAs(const RayQueryObject& other) const { return state_ == other.state_; }
 
 private:
+    friend void detail::runTraceRayInlineCalls(std::span<void* const> lanes);
+    // TraceRayInline up to its candidates: true when the query's ray goes on to gather them (a valid ray in a TLAS).
+    bool initialise(GpuVirtualAddress accelerationStructure, uint32_t rayFlags, uint32_t mask, const RayDesc& ray);
+
     std::shared_ptr<detail::RayQueryState> state_;
 };
 

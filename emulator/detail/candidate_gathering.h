@@ -34,4 +34,9 @@ void gatherOrderedCandidates(std::span<GatherRay> rays);
 // and TraceRays may be live at once). No traversal shortcut: the owning shader decides for each candidate.
 void gatherQueryCandidates(ThreadState& ts, RayState& rs, const Site& site, std::vector<Candidate>& out);
 
+// gatherQueryCandidates for several queries' rays at once (the lanes of a wave whose queries trace together), ray k's
+// candidates into outs[k]: the rays that share a TLAS traverse in Embree packets of up to kMaxGatherPacket, in order,
+// and each gets the candidates, order and statistics it gets alone. What fails for one ray goes to its `error`.
+void gatherQueryCandidatesPacket(std::span<GatherRay> rays, std::span<std::vector<Candidate>* const> outs);
+
 }  // namespace refray::dxr::detail

@@ -7,6 +7,7 @@
 #include <optional>
 #include <span>
 #include <type_traits>
+#include <utility>
 
 #include "emulator/closest_hit_wave.h"
 #include "emulator/compute_wave.h"
@@ -542,34 +543,56 @@ float committedRayT(const RayQueryObject& q, float rayTMax, InlineVariant v) {
 // loops together and their tests as wave calls (emulator/wave_call.h): proceed(call) runs the loop up to the next
 // procedural candidate and returns true with its test as `call` (IntersectPrimitive for the lanes that make one, in
 // float: runPrimitiveCalls, runSignedDistanceCalls), or false once Proceed returns FALSE; the next proceed commits
-// the test's hit and goes on. A shader written for waves runs its lanes' loops through ShaderWave::CallsInLoop; one
-// lane alone makes its calls through its ShaderContext (runAlone). double and PerturbedFloat test at once, for
-// withLaneType's reasons. The variant (InlineVariant) changes only the lines its comment names.
+// the test's hit and goes on. Its TraceRayInline is a wave call too (traceRayInlineCall: the wave's queries' rays
+// gather their candidates in Embree packets): trace(ray) readies it, and the next proceed hands it out. A shader
+// written for waves runs its lanes' loops through ShaderWave::CallsInLoop. double and PerturbedFloat test at once,
+// for withLaneType's reasons. The variant (InlineVariant) changes only the lines its comment names.
 template <typename T>
 class InlineQueryLoop {
 public:
-    // RayQuery<templateFlags> q; q.TraceRayInline(the scene, RAY_FLAG_NONE, instanceMask, ray). `commitTriangles`:
-    // the loop commits its triangle candidates (the shadow query's are opaque, committed inside Proceed, RQ-14).
-    InlineQueryLoop(ShaderContext& ctx, uint32_t templateFlags, uint32_t instanceMask, const RayDesc& ray,
-                    bool commitTriangles, const Accuracy& accuracy, InlineVariant variant)
-        : ctx_(&ctx), q_(ctx, templateFlags, RAYQUERY_FLAG_NONE), scene_(ctx.globalRootDescriptor(kAccelerationStructure)),
-          instanceMask_(instanceMask), commitTriangles_(commitTriangles), accuracy_(&accuracy), variant_(variant) {
-        retrace(ray);
+    // RayQuery<templateFlags> q, whose TraceRayInline(the scene, RAY_FLAG_NONE, instanceMask, ray) trace(ray) readies.
+    // `commitTriangles`: the loop commits its triangle candidates (the shadow query's are opaque, committed inside
+    // Proceed, RQ-14).
+    InlineQueryLoop(ShaderContext& ctx, uint32_t templateFlags, uint32_t instanceMask, bool commitTriangles,
+                    const Accuracy& accuracy, InlineVariant variant)
+        : ctx_(&ctx), q_(ctx, templateFlags, RAYQUERY_FLAG_NONE), commitTriangles_(commitTriangles),
+          accuracy_(&accuracy), variant_(variant) {
+        traceCall_.query = &q_;
+        traceCall_.accelerationStructure = ctx.globalRootDescriptor(kAccelerationStructure);
+        traceCall_.instanceInclusionMask = instanceMask;
     }
-    // The same query traced again, along `ray` (RQ-9: what the object held is discarded), as a new RayQuery of the
-    // same flags would trace it.
+    // q.TraceRayInline(the scene, RAY_FLAG_NONE, instanceMask, ray), made by the next proceed. A lane's next query
+    // of the same kind traces the same object again (RQ-9: what it held is discarded), as a new RayQuery of the same
+    // flags would trace it.
     // PORT: the HLSL declares a RayQuery per call of TraceAnyHitInline; one object traced again is the same query
-    // (same checks, counts and events), made once per lane (and the scene's address read once).
-    void retrace(const RayDesc& ray) {
+    // (the same checks, counts and events), made once per lane, with the scene's address read once.
+    void trace(const RayDesc& ray) {
         pending_ = false;
+        tracing_ = true;
         committedNormal_ = tvec3<T>(T(0));
-        rayTMax_ = ray.TMax;
-        q_.TraceRayInline(scene_, RAY_FLAG_NONE, instanceMask_, ray);
+        traceCall_.ray = ray;
     }
     InlineQueryLoop(const InlineQueryLoop&) = delete;
     InlineQueryLoop& operator=(const InlineQueryLoop&) = delete;
 
+    // trace(ray), made at once, alone: for a lane whose next query follows its last one in the same step, so that it
+    // reaches its first procedural test in that step rather than wait a round for its TraceRayInline.
+    void traceNow(const RayDesc& ray) {
+        trace(ray);
+        tracing_ = false;
+        q_.TraceRayInline(traceCall_.accelerationStructure, traceCall_.rayFlags, traceCall_.instanceInclusionMask, ray);
+    }
+
     bool proceed(WaveCall& call) {
+        if (tracing_) {  // the TraceRayInline first: handed out, then done
+            if (!traced_) {
+                traced_ = true;
+                call = traceRayInlineCall(traceCall_);
+                return true;
+            }
+            tracing_ = traced_ = false;
+            if (traceCall_.failure) std::rethrow_exception(std::exchange(traceCall_.failure, nullptr));
+        }
         if (pending_) {
             pending_ = false;
             if constexpr (std::is_same_v<T, float>) commitTest(call_.result);
@@ -582,17 +605,20 @@ public:
             if (variant_ == InlineVariant::IgnoreProcedural) continue;  // LESSON: the candidate is never intersected
             const InlinePrimitive primitive =
                 ctx_->loadStructured<InlinePrimitive>(kInlinePrimitivesRegister, 0, 0, q_.CandidateGeometryIndex());
+            // PORT: the attribute buffer's address and the scene's elapsedTime are read once per query object.
+            if (!aabbAttributes_) aabbAttributes_ = ctx_->globalRootDescriptor(kAABBattributeBuffer);
             aabbAttribute_ = ctx_->load<PrimitiveInstancePerFrameBuffer>(
-                ctx_->globalRootDescriptor(kAABBattributeBuffer) +
-                uint64_t(primitive.instanceIndex) * sizeof(PrimitiveInstancePerFrameBuffer));
+                *aabbAttributes_ + uint64_t(primitive.instanceIndex) * sizeof(PrimitiveInstancePerFrameBuffer));
             const math::Ray<T> localRay = GetRayInAABBPrimitiveLocalSpace<T>(
                 q_.CandidateObjectRayOrigin(), q_.CandidateObjectRayDirection(), aabbAttribute_);
             const auto shader = IntersectionShader(primitive.intersectionShader);
-            const T elapsedTime = shader == IntersectionShader::VolumetricPrimitive ? T(sceneCB(*ctx_).elapsedTime) : T(0);
+            if (shader == IntersectionShader::VolumetricPrimitive && !elapsedTime_)
+                elapsedTime_ = sceneCB(*ctx_).elapsedTime;
+            const T elapsedTime = shader == IntersectionShader::VolumetricPrimitive ? T(*elapsedTime_) : T(0);
             const math::RayExtent<T> extent =
                 variant_ == InlineVariant::NoRangeCheck
-                    ? CurrentExtent<T>(-rayTMax_, rayTMax_, q_.RayFlags())  // MUTANT: the whole line
-                    : CurrentExtent<T>(q_.RayTMin(), committedRayT(q_, rayTMax_, variant_), q_.RayFlags());
+                    ? CurrentExtent<T>(-rayTMax(), rayTMax(), q_.RayFlags())  // MUTANT: the whole line
+                    : CurrentExtent<T>(q_.RayTMin(), committedRayT(q_, rayTMax(), variant_), q_.RayFlags());
             objectToWorld_ = q_.CandidateObjectToWorld3x4();
             if constexpr (std::is_same_v<T, float>) {
                 call_ = {shader, primitive.primitiveType, accuracy_, localRay, extent, elapsedTime, primitive.stepScale, {}};
@@ -608,14 +634,9 @@ public:
         return false;
     }
 
-    // The whole loop for a lane alone: its tests are its ShaderContext's wave calls.
-    void runAlone() {
-        WaveCall call;
-        while (proceed(call)) ctx_->callInWave(*call.function, call.key, call.state);
-    }
-
+    RayQueryObject& query() { return q_; }
     const RayQueryObject& query() const { return q_; }
-    float rayTMax() const { return rayTMax_; }
+    float rayTMax() const { return traceCall_.ray.TMax; }
     // The world normal of the procedural hit committed last (zero before one): the system keeps no attributes of a
     // procedural hit (RQ-23), the shader keeps them.
     const tvec3<T>& committedNormal() const { return committedNormal_; }
@@ -631,9 +652,10 @@ private:
 
     ShaderContext* ctx_;
     RayQueryObject q_;
-    GpuVirtualAddress scene_;
-    uint32_t instanceMask_;
-    float rayTMax_ = 0.0f;
+    RayQueryTraceCall traceCall_;  // the query's TraceRayInline
+    std::optional<GpuVirtualAddress> aabbAttributes_;  // g_AABBPrimitiveAttributes, once read
+    std::optional<float> elapsedTime_;                 // g_sceneCB.elapsedTime, once read
+    bool tracing_ = false, traced_ = false;
     bool commitTriangles_;
     const Accuracy* accuracy_;
     InlineVariant variant_;
@@ -650,15 +672,19 @@ private:
 // PORT: RayQuery<kInlineShadowQueryFlags> q; the object is made with the variant's template flags
 // (inlineShadowQueryFlags), which for AsWritten are kInlineShadowQueryFlags.
 // PORT: TraceRayParameters::InstanceMask is the library's shadow-ray mask, as in the TraceRay version.
-// PORT: a lane's next query (`loop` already made: its next occlusion ray) traces the same object again (retrace).
+// PORT: a lane's next query (`loop` already made: its next occlusion ray) traces the same object again
+// (InlineQueryLoop::trace).
+// PORT: `now`: the query is traced at once (InlineQueryLoop::traceNow), else by the loop's next proceed.
 template <typename T>
 void AnyHitQuery(std::optional<InlineQueryLoop<T>>& loop, ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
                  const Accuracy& accuracy, const tvec3<T>& origin, const tvec3<T>& direction, float tMax,
-                 InlineVariant variant) {
-    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), tMax};
-    if (loop) return loop->retrace(rayDesc);  // a lane's next shadow or occlusion query
-    loop.emplace(ctx, inlineShadowQueryFlags(variant), traceRay[RayType::Shadow].instanceInclusionMask, rayDesc,
-                 /*commitTriangles*/ false, accuracy, variant);
+                 InlineVariant variant, bool now = false) {
+    if (!loop)
+        loop.emplace(ctx, inlineShadowQueryFlags(variant), traceRay[RayType::Shadow].instanceInclusionMask,
+                     /*commitTriangles*/ false, accuracy, variant);
+    const RayDesc ray{vec3(origin), 0.0f, vec3(direction), tMax};
+    if (now) loop->traceNow(ray);
+    else loop->trace(ray);
 }
 
 // TraceAnyHitInline's result, after its loop.
@@ -772,8 +798,8 @@ void SampleClosestHit(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay,
     wave.forEachLane([&](int i, ShaderContext& ctx) {
         ClosestHitLane<T>& l = lanes[size_t(i)];
         openLane(i, ctx, l);
-        if (ShadowQueryInline(shadowQueries[size_t(i)], ctx, traceRay, maxDepth, effects, accuracy, l.hitPosition, l.toLight,
-                              wave.payload<RayPayload>(i).recursionDepth, variant))
+        if (ShadowQueryInline(shadowQueries[size_t(i)], ctx, traceRay, maxDepth, effects, accuracy, l.hitPosition,
+                              l.toLight, wave.payload<RayPayload>(i).recursionDepth, variant))
             querying.set(i);
     });
     wave.CallsInLoop(querying, [&](int i, ShaderContext&, WaveCall& call) {
@@ -870,7 +896,7 @@ float UnitFloat(uint32_t h) { return float(h >> 8) * (1.0f / 16777216.0f); }
 // The cosine-weighted hemisphere around n, in the orthonormal basis of Duff et al. (JCGT 2017).
 template <typename T>
 tvec3<T> CosineHemisphereDirection(const tvec3<T>& n, T u1, T u2) {
-    const T s = n.z >= T(0) ? T(1) : T(-1);
+    const T s = math::select(n.z >= T(0), T(1), T(-1));  // PORT: select, so that T may be lanes
     const T a = T(-1) / (s + n.z);
     const T b = n.x * n.y * a;
     const tvec3<T> t1(T(1) + s * n.x * n.x * a, s * b, -s * n.x);
@@ -886,10 +912,10 @@ tvec3<T> CosineHemisphereDirection(const tvec3<T>& n, T u1, T u2) {
 template <typename T>
 void PrimaryQuery(std::optional<InlineQueryLoop<T>>& loop, ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
                   const Accuracy& accuracy, const tvec3<T>& origin, const tvec3<T>& direction, InlineVariant variant) {
-    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     static_assert(rayQueryTemplateError(kInlinePrimaryQueryFlags, RAYQUERY_FLAG_NONE) == nullptr);
-    loop.emplace(ctx, kInlinePrimaryQueryFlags, traceRay[RayType::Radiance].instanceInclusionMask, rayDesc,
+    loop.emplace(ctx, kInlinePrimaryQueryFlags, traceRay[RayType::Radiance].instanceInclusionMask,
                  /*commitTriangles*/ true, accuracy, variant);
+    loop->trace(RayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f});
 }
 
 // TracePrimaryInline's result, after its loop: whether it hit, with the hit's position and normal.
@@ -918,17 +944,36 @@ bool PrimaryQueryResult(ShaderContext& ctx, const InlineQueryLoop<T>& loop, cons
     return true;
 }
 
-// TraceOcclusionInline's query: the occlusion ray `ray` (0 .. AO_RAY_COUNT-1) of the pixel whose hash is `seed`,
-// from `hitPosition` around `normal`; it meets a surface when any lies within AO_RADIUS: the shadow rays' query.
+// The AO_RAY_COUNT occlusion rays' directions of the pixel whose hash is `seed`, around `normal`: ray i's is
+// CosineHemisphereDirection(normal, u1, u2) with u1 = UnitFloat(Hash(seed ^ 2i)), u2 = UnitFloat(Hash(seed ^ (2i + 1))).
+// PORT: in float the HLSL's loop computes them one ray at a time; here they are computed at once over WaveLanes<float>
+// (ray i in lane i), each lane bit for bit its ray's scalar direction (procedural/math/lanes.h). The other types go
+// ray by ray.
+template <typename T>
+std::array<tvec3<T>, AO_RAY_COUNT> OcclusionDirections(uint32_t seed, const tvec3<T>& normal) {
+    const auto u = [seed](uint32_t i) { return UnitFloat(Hash(seed ^ i)); };
+    std::array<tvec3<T>, AO_RAY_COUNT> out;
+    if constexpr (std::is_same_v<T, float> && int(AO_RAY_COUNT) == kWaveLanes) {
+        using L = WaveLanes<float>;
+        [[maybe_unused]] PrecisionScope<L> scope;
+        const L u1 = L::generate([&](int i) { return u(2 * uint32_t(i)); });
+        const L u2 = L::generate([&](int i) { return u(2 * uint32_t(i) + 1); });
+        const tvec3<L> d = CosineHemisphereDirection(tvec3<L>(normal), u1, u2);
+        for (uint32_t i = 0; i < AO_RAY_COUNT; ++i) out[i] = math::lane(d, int(i));
+    } else {
+        for (uint32_t i = 0; i < AO_RAY_COUNT; ++i) out[i] = CosineHemisphereDirection(normal, T(u(2 * i)), T(u(2 * i + 1)));
+    }
+    return out;
+}
+
+// TraceOcclusionInline's query: the occlusion ray along `direction` from `hitPosition` off `normal`; it meets a
+// surface when any lies within AO_RADIUS: the shadow rays' query.
 template <typename T>
 void OcclusionQuery(std::optional<InlineQueryLoop<T>>& loop, ShaderContext& ctx, const TraceRayArgumentSet& traceRay,
-                    const Accuracy& accuracy, uint32_t seed, uint32_t ray, const tvec3<T>& hitPosition,
-                    const tvec3<T>& normal, InlineVariant variant) {
-    const T u1 = T(UnitFloat(Hash(seed ^ (2 * ray))));
-    const T u2 = T(UnitFloat(Hash(seed ^ (2 * ray + 1))));
-    const tvec3<T> direction = CosineHemisphereDirection(normal, u1, u2);
+                    const Accuracy& accuracy, const tvec3<T>& direction, const tvec3<T>& hitPosition,
+                    const tvec3<T>& normal, InlineVariant variant, bool now = false) {
     AnyHitQuery(loop, ctx, traceRay, accuracy, hitPosition + T(AO_ORIGIN_OFFSET) * normal, direction, AO_RADIUS,
-                variant);
+                variant, now);
 }
 
 // [numthreads(8, 8, 1)] InlineAmbientOcclusionCS: one thread per pixel; threads past the render target's edge return.
@@ -937,9 +982,11 @@ void OcclusionQuery(std::optional<InlineQueryLoop<T>>& loop, ShaderContext& ctx,
 //       for (i = 0; i < AO_RAY_COUNT; ++i) if (!TraceOcclusionInline(...ray i...)) escaped++;
 //       color = float4(ao, ao, ao, 1) with ao = escaped / AO_RAY_COUNT;
 //   }
-// PORT: written for waves (emulator/compute_wave.h): each lane's code up to its primary query's loop, the lanes'
-// loops together (ComputeWave::CallsInLoop, InlineQueryLoop), each lane's result; then each lane's occlusion rays,
-// one after another in the lane, their loops together; then each lane's colour.
+// PORT: written for waves (emulator/compute_wave.h): each lane's code up to its primary query; the lanes' query
+// loops together (ComputeWave::CallsInLoop, InlineQueryLoop: their TraceRayInlines and procedural tests are wave
+// calls); each lane's result and its rays' directions (OcclusionDirections); then each lane's occlusion rays, one
+// after another in the lane, their loops together (the first rays' TraceRayInlines go out together; a lane's next
+// ray is traced at once as its last ends, InlineQueryLoop::traceNow); then each lane's colour.
 template <typename T>
 void InlineAmbientOcclusionCS(ComputeWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
                               InlineVariant variant) {
@@ -949,7 +996,8 @@ void InlineAmbientOcclusionCS(ComputeWave& wave, const TraceRayArgumentSet& trac
         uvec2 id{0u};
         tvec3<T> origin, rayDir, hitPosition, normal;
         std::optional<InlineQueryLoop<T>> primary, occlusion;
-        uint32_t seed = 0, ray = 0, escaped = 0;
+        std::array<tvec3<T>, AO_RAY_COUNT> directions;
+        uint32_t ray = 0, escaped = 0;
         bool hit = false;
     };
     std::array<Lane, kMaxWaveWidth> lanes;
@@ -974,8 +1022,8 @@ void InlineAmbientOcclusionCS(ComputeWave& wave, const TraceRayArgumentSet& trac
         if (!inside.test(i)) return;
         l.hit = PrimaryQueryResult(ctx, *l.primary, l.origin, l.rayDir, l.hitPosition, l.normal, variant);
         if (!l.hit) return;
-        l.seed = Hash(l.id.x ^ Hash(l.id.y));
-        OcclusionQuery(l.occlusion, ctx, traceRay, accuracy, l.seed, 0, l.hitPosition, l.normal, variant);
+        l.directions = OcclusionDirections(Hash(l.id.x ^ Hash(l.id.y)), l.normal);
+        OcclusionQuery(l.occlusion, ctx, traceRay, accuracy, l.directions[0], l.hitPosition, l.normal, variant);
         occluded.set(i);
     });
     wave.CallsInLoop(occluded, [&](int i, ShaderContext& ctx, WaveCall& call) {
@@ -983,7 +1031,8 @@ void InlineAmbientOcclusionCS(ComputeWave& wave, const TraceRayArgumentSet& trac
         while (!l.occlusion->proceed(call)) {  // the lane's occlusion ray l.ray is over
             if (!AnyHitQueryResult(*l.occlusion)) l.escaped++;
             if (++l.ray == AO_RAY_COUNT) return false;
-            OcclusionQuery(l.occlusion, ctx, traceRay, accuracy, l.seed, l.ray, l.hitPosition, l.normal, variant);
+            OcclusionQuery(l.occlusion, ctx, traceRay, accuracy, l.directions[l.ray], l.hitPosition, l.normal, variant,
+                           /*now*/ true);
         }
         return true;
     });

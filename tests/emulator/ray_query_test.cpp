@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "dispatch_rig.h"
+#include "emulator/compute_wave.h"
 #include "emulator/ray_query.h"
 
 namespace refray::test {
@@ -1905,6 +1906,107 @@ TEST(ComputeDispatch, SV_1_RayTracingSystemValuesAreRefusedInCompute) {
     const Diagnostic d = expectDxrError("SV-1", [&] { r.run({}); });
     ASSERT_TRUE(d.site);
     EXPECT_EQ(d.site->stage, ShaderStage::RayGeneration);
+}
+
+// A compute shader written for waves whose lanes make their TraceRayInline as wave calls (traceRayInlineCall, through
+// ShaderWave::CallsInLoop): the rays of a wave's queries gather their candidates in Embree packets, and each lane must
+// find what it finds alone, at every width: the same candidates in the same order, the same committed hit, the same
+// statistics and diagnostics. Thread 5's ray has a NaN direction (RQ-11) and thread 11's a TMin above its TMax: their
+// queries find nothing; under OnError::Stop the dispatch stops with thread 5's error, and the other lanes of its wave
+// still finish.
+TEST(ComputeWave, RQ_13_QueriesTracedTogetherFindWhatEachFindsAlone) {
+    Rig r;
+    oneInstance(r, r.h.triangles(trisAt({0.0f, 2.0f, 4.0f, 7.0f}), GEOMETRY_FLAG_NONE));  // non-opaque: candidates
+    const uvec2 grid(7, 5);
+    struct Result {
+        std::vector<float> candidates;  // their t, in the order Proceed hands them out
+        uint32_t status = 0;
+        float t = 0.0f;
+        bool done = false;
+    };
+    std::vector<Result> results;
+    r.h.library->addWaveCompute("CSW", uvec3(1u), [&, scene = r.h.scene](ComputeWave& wave) {
+        std::array<std::optional<RayQueryObject>, kMaxWaveWidth> queries;
+        std::array<RayQueryTraceCall, kMaxWaveWidth> traces;
+        std::array<bool, kMaxWaveWidth> traced{};
+        const auto number = [&grid](ShaderContext& ctx) {
+            return ctx.DispatchThreadID().y * grid.x + ctx.DispatchThreadID().x;
+        };
+        wave.forEachLane([&](int i, ShaderContext& ctx) {
+            const uint32_t n = number(ctx);
+            RayDesc ray = zRay();
+            ray.Origin.x = -0.6f + 0.08f * float(n % 13);  // some rays pass beside the triangles
+            ray.TMax = 6.0f + float(n % 4) * 2.0f;         // and some end before the far ones
+            if (n == 5) ray.Direction.y = kNaN;
+            if (n == 11) ray.TMin = 100.0f;
+            queries[size_t(i)].emplace(ctx, RAY_FLAG_NONE, RAYQUERY_FLAG_NONE);
+            traces[size_t(i)] = RayQueryTraceCall{&*queries[size_t(i)], scene, RAY_FLAG_NONE, 0xFF, ray, nullptr};
+        });
+        wave.CallsInLoop(wave.active(), [&](int i, ShaderContext& ctx, WaveCall& call) {
+            if (!traced[size_t(i)]) {
+                traced[size_t(i)] = true;
+                call = traceRayInlineCall(traces[size_t(i)]);
+                return true;
+            }
+            if (traces[size_t(i)].failure) std::rethrow_exception(traces[size_t(i)].failure);
+            RayQueryObject& q = *queries[size_t(i)];
+            Result& res = results[number(ctx)];
+            while (q.Proceed()) {
+                res.candidates.push_back(q.CandidateTriangleRayT());
+                if (q.CandidateTriangleRayT() > 6.5f) q.CommitNonOpaqueTriangleHit();  // a chosen hit, not the nearest
+            }
+            res.status = q.CommittedStatus();
+            res.t = q.CommittedRayT();
+            res.done = true;
+            return false;
+        });
+    });
+    declare(r, "CSW", {RAY_FLAG_NONE});
+    r.build();
+    const auto run = [&](uint32_t width, OnError onError) {
+        results.assign(size_t(grid.x) * grid.y, Result{});
+        DispatchOptions o;
+        o.waveWidth = width;
+        o.tileSize = 64;  // one tile: its waves hold `width` lanes
+        o.onError = onError;
+        return r.h.device.dispatch(DispatchDesc{"CSW", grid.x, grid.y, 1}, r.so, nullptr, o);
+    };
+    const DispatchResult alone = run(1, OnError::Continue);
+    const std::vector<Result> aloneResults = results;
+    EXPECT_TRUE(hasRule(alone.diagnostics.diagnostics(), "RQ-11")) << "the refused rays are reported";
+    size_t hits = 0, found = 0;
+    for (const Result& res : aloneResults) {
+        hits += res.status == COMMITTED_TRIANGLE_HIT;
+        found += res.candidates.size();
+    }
+    EXPECT_GT(hits, 0u);
+    EXPECT_GT(found, hits);  // rays with several candidates
+    for (const uint32_t width : {3u, 16u, 32u}) {
+        const DispatchResult waved = run(width, OnError::Continue);
+        for (size_t n = 0; n < results.size(); ++n) {
+            EXPECT_TRUE(results[n].done) << "width " << width << ", thread " << n;
+            EXPECT_EQ(results[n].candidates, aloneResults[n].candidates) << "width " << width << ", thread " << n;
+            EXPECT_EQ(results[n].status, aloneResults[n].status) << "width " << width << ", thread " << n;
+            EXPECT_EQ(results[n].t, aloneResults[n].t) << "width " << width << ", thread " << n;
+        }
+        std::vector<std::string> a, b;
+        for (const Diagnostic& d : alone.diagnostics.diagnostics()) a.push_back(d.format());
+        for (const Diagnostic& d : waved.diagnostics.diagnostics()) b.push_back(d.format());
+        std::sort(a.begin(), a.end());
+        std::sort(b.begin(), b.end());
+        EXPECT_EQ(b, a) << "width " << width;
+        EXPECT_EQ(waved.stats.rayQueries, alone.stats.rayQueries) << "width " << width;
+        EXPECT_EQ(waved.stats.candidates, alone.stats.candidates) << "width " << width;
+        EXPECT_EQ(waved.stats.queryCandidates, alone.stats.queryCandidates) << "width " << width;
+    }
+    // OnError::Stop: thread 5's RQ-11 stops the dispatch; the lanes of its wave that trace well still finish.
+    const Diagnostic d = expectDxrError("RQ-11", [&] { run(16, OnError::Stop); });
+    ASSERT_TRUE(d.site);
+    EXPECT_EQ(d.site->launchIndex, uvec3(5, 0, 0));
+    EXPECT_EQ(d.site->stage, ShaderStage::Compute);
+    EXPECT_FALSE(results[5].done);
+    EXPECT_TRUE(results[4].done);
+    EXPECT_EQ(results[4].candidates, aloneResults[4].candidates);
 }
 
 TEST(ComputeDispatch, RAY_2_TraceRayAndCallShaderAreRefusedInCompute) {
