@@ -56,10 +56,9 @@ void runTestCalls(std::span<void* const> lanes) {
     if (fail) throw Error("the wave call failed on purpose");
 }
 
-// A rig whose ray generation shader hands one wave call per launch to its wave (key: the launch's number, y * width
-// + x, modulo `keys`) and writes the call's output to `outputs`. A 4x4 grid is one wave of 16 lanes (waves are 4x4
-// blocks), in lane order of its numbers.
-struct WaveCallRig {
+// What the rigs below share: the dispatch rig, the calls' log and function, how many keys the calls spread over, the
+// launch whose call fails, the grid and each launch's output.
+struct CallRigParts {
     Rig r;
     Log log;
     WaveFunction function{runTestCalls, 8};
@@ -67,8 +66,16 @@ struct WaveCallRig {
     uint32_t failOn = ~0u;
     uvec2 grid;
     std::vector<uint32_t> outputs;
+};
 
-    explicit WaveCallRig(uvec2 size) : grid(size), outputs(size_t(size.x) * size.y, 0u) {
+// A rig whose ray generation shader hands one wave call per launch to its wave (key: the launch's number, y * width
+// + x, modulo `keys`) and writes the call's output to `outputs`. A 4x4 grid is one wave of 16 lanes (waves are 4x4
+// blocks), in lane order of its numbers.
+struct WaveCallRig : CallRigParts {
+
+    explicit WaveCallRig(uvec2 size) {
+        grid = size;
+        outputs.assign(size_t(size.x) * size.y, 0u);
         r.rg = [this](ShaderContext& ctx) {
             LaneState s;
             s.launch = ctx.DispatchRaysIndex().y * grid.x + ctx.DispatchRaysIndex().x;
@@ -161,16 +168,11 @@ TEST(WaveCall, GEN_1_AFailingCallStopsTheLaunchesOfItsLanes) {
 // wave calls together (ShaderWave::CallsInLoop): the thread of number n (y * width + x) makes n % 3 + 1 calls, one
 // after another, call k with key (n + k) % keys, and writes the sum of their outputs, (n % 3 + 1) * (3n + 1), and the
 // number of calls it made.
-struct ComputeLoopRig {
-    Rig r;
-    Log log;
-    WaveFunction function{runTestCalls, 8};
-    uint32_t keys = 1;
-    uint32_t failOn = ~0u;
-    uvec2 grid;
-    std::vector<uint32_t> outputs, made;
+struct ComputeLoopRig : CallRigParts {
+    std::vector<uint32_t> made;
 
-    explicit ComputeLoopRig(uvec2 size) : grid(size) {
+    explicit ComputeLoopRig(uvec2 size) {
+        grid = size;
         r.h.library->addWaveCompute("CSW", uvec3(1u), [this](ComputeWave& wave) {
             std::array<LaneState, kMaxWaveWidth> states{};
             std::array<uint32_t, kMaxWaveWidth> calls{}, sums{};
