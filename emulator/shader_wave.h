@@ -90,7 +90,6 @@ protected:
     void rethrowAloneFailure() const {
         if (failures_[0]) std::rethrow_exception(failures_[0]);
     }
-    ShaderContext& context(int lane) const { return *contexts_[size_t(lane)]; }
     detail::Wave* wave() const { return wave_; }
 
 private:

@@ -14,7 +14,7 @@ void TracingWave::TraceRay(LaneMask lanes, std::span<const TraceRayCall> calls) 
     if (runsAlone()) {
         for (int i : tracing) {
             try {
-                context(i).TraceRay(calls[size_t(i)]);
+                lane(i).TraceRay(calls[size_t(i)]);
             } catch (...) {
                 fail(i, std::current_exception());
             }
@@ -23,7 +23,7 @@ void TracingWave::TraceRay(LaneMask lanes, std::span<const TraceRayCall> calls) 
     }
     // RAY-2 holds (ray generation and closest-hit shaders may trace), and no ReportHit can have ended either stage.
     std::array<detail::Invocation*, kMaxWaveWidth> callers{};
-    for (int i : tracing) callers[size_t(i)] = &context(i).inv_;
+    for (int i : tracing) callers[size_t(i)] = &lane(i).inv_;
     std::array<std::exception_ptr, kMaxWaveWidth> failures{};
     detail::traceRaysInWave(*wave(), callers, calls.data(), tracing, failures);
     for (int i : tracing)

@@ -1119,20 +1119,15 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
                                  MyRaygenShader<T>(wave, traceRay, accuracy);
                              }));
     // The sample's closest hits, as <name><suffix>, for one way of tracing their shadow rays (and one variant of the
-    // inline way). Traced with TraceRay they run as waves (addWaveClosestHit). Traced inline they run a lane at a
-    // time, on the lanes' fibers (ClosestHitWave::runAlone): there the intersection tests of their ray queries go out
-    // as wave calls over the wave's lanes (emulator/wave_call.h), which a wave of closest hits, on the wave's stack,
-    // would make one lane at a time.
+    // inline way), written for waves (addWaveClosestHit): traced inline, their lanes' queries run in lockstep
+    // (SampleClosestHit).
     const auto addClosestHits = [&](const std::string& suffix, ShadowTracing tracing, InlineVariant variant) {
-        const auto add = [&]<class Attributes>(const std::string& name, WaveClosestHitShader shader) {
-            lib.addWaveClosestHit<RayPayload, Attributes>(name, std::move(shader));
-        };
-        add.template operator()<BuiltInTriangleIntersectionAttributes>(
+        lib.addWaveClosestHit<RayPayload, BuiltInTriangleIntersectionAttributes>(
             "MyClosestHitShader_Triangle" + suffix,
             in([traceRay, accuracy, effects, tracing, variant](ClosestHitWave& wave) {
                 MyClosestHitShader_Triangle<T>(wave, traceRay, accuracy, effects, tracing, variant);
             }));
-        add.template operator()<ProceduralPrimitiveAttributes>(
+        lib.addWaveClosestHit<RayPayload, ProceduralPrimitiveAttributes>(
             "MyClosestHitShader_AABB" + suffix, in([traceRay, accuracy, effects, tracing, variant](ClosestHitWave& wave) {
                 MyClosestHitShader_AABB<T>(wave, traceRay, accuracy, effects, tracing, variant);
             }));
