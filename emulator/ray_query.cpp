@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -61,6 +62,7 @@ struct QueryHit {
 };
 
 struct RayQueryState {
+    uint32_t handles = 0;  // the RayQueryObjects that refer to it
     Invocation* inv = nullptr;
     uint32_t templateFlags = 0;
     uint32_t rayQueryFlags = 0;
@@ -231,8 +233,47 @@ bool advance(RayQueryState& q) {
 using detail::QueryPhase;
 using detail::RayQueryState;
 
+namespace {
+
+// The states this worker thread's queries no longer use, at most kSpareQueryStates of them. A state never leaves the
+// thread that made its query (its invocation runs there), and each thread keeps its own.
+constexpr size_t kSpareQueryStates = 256;
+thread_local std::vector<std::unique_ptr<RayQueryState>> tSpareQueryStates;
+
+// A fresh state (Fresh, nothing traced), a spare one where the thread has one: its candidate list keeps its storage.
+RayQueryState* takeQueryState() {
+    if (tSpareQueryStates.empty()) return new RayQueryState();
+    RayQueryState* q = tSpareQueryStates.back().release();
+    tSpareQueryStates.pop_back();
+    std::vector<detail::Candidate> candidates = std::move(q->candidates);
+    candidates.clear();
+    *q = RayQueryState{};
+    q->candidates = std::move(candidates);
+    return q;
+}
+
+void releaseQueryState(RayQueryState* q) {
+    if (!q || --q->handles > 0) return;
+    if (tSpareQueryStates.size() < kSpareQueryStates) tSpareQueryStates.emplace_back(q);
+    else delete q;
+}
+
+}  // namespace
+
+RayQueryObject::RayQueryObject(const RayQueryObject& other) : state_(other.state_) { ++state_->handles; }
+
+RayQueryObject& RayQueryObject::operator=(const RayQueryObject& other) {
+    ++other.state_->handles;  // first: assigning a handle to itself keeps its state
+    releaseQueryState(state_);
+    state_ = other.state_;
+    return *this;
+}
+
+RayQueryObject::~RayQueryObject() { releaseQueryState(state_); }
+
 RayQueryObject::RayQueryObject(ShaderContext& ctx, uint32_t templateRayFlags, uint32_t rayQueryFlags)
-    : state_(std::make_shared<RayQueryState>()) {
+    : state_(takeQueryState()) {
+    state_->handles = 1;
     state_->inv = &ctx.inv_;
     state_->templateFlags = templateRayFlags;
     state_->rayQueryFlags = rayQueryFlags;

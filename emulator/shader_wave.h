@@ -8,6 +8,7 @@
 
 #include <array>
 #include <exception>
+#include <functional>
 #include <span>
 
 #include "emulator/lane_mask.h"
@@ -89,6 +90,17 @@ protected:
     // For a shader run for one lane alone (lane 0 of a wave without a Wave): rethrows what stopped the lane.
     void rethrowAloneFailure() const {
         if (failures_[0]) std::rethrow_exception(failures_[0]);
+    }
+    // `shader`, written for waves of type W, run for `ctx`'s lane alone (width 1, `explain`, `--stats`): W is made for
+    // lane 0 from `lanes` (W's per-lane arrays after the contexts, lane 0's entry set); what stopped the lane is
+    // rethrown. Each kind's runAlone.
+    template <class W, class... Lanes>
+    static void runLaneAlone(const std::function<void(W&)>& shader, ShaderContext& ctx, const Lanes&... lanes) {
+        std::array<ShaderContext*, kMaxWaveWidth> contexts{};
+        contexts[0] = &ctx;
+        W wave(contexts, LaneMask::only(0), nullptr, lanes...);
+        shader(wave);
+        static_cast<const ShaderWave&>(wave).rethrowAloneFailure();
     }
     detail::Wave* wave() const { return wave_; }
 

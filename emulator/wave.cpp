@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "emulator/closest_hit_wave.h"
+#include "emulator/detail/lane_slots.h"
 #include "emulator/detail/record_grouping.h"
 #include "emulator/detail/shader_invocation.h"
 #include "emulator/detail/trace_ray.h"
@@ -147,18 +148,18 @@ struct LaneTrace {
 
 // A closest-hit shader written for waves, run once over `lanes`, the lanes of the wave whose rays selected it (their
 // invocations in `hits`), on the wave's stack; each lane's TraceRay then ends as it ends alone.
-void runClosestHitWave(Wave& wave, const ShaderExport& shader, LaneMask lanes, std::array<LaneTrace, kMaxWaveWidth>& traces,
-                       std::array<Invocation, kMaxWaveWidth>& hits) {
+void runClosestHitWave(Wave& wave, const ShaderExport& shader, LaneMask lanes, LaneSlots<LaneTrace>& traces,
+                       LaneSlots<Invocation>& hits) {
     std::array<std::optional<ShaderContext>, kMaxWaveWidth> contexts;
     std::array<ShaderContext*, kMaxWaveWidth> contextOf{};
     std::array<void*, kMaxWaveWidth> payloads{};
     std::array<const void*, kMaxWaveWidth> attributes{};
     std::array<uint8_t, kMaxWaveWidth> callerSections{};
     for (int i : lanes) {
-        callerSections[size_t(i)] = beginInvocation(*hits[size_t(i)].thread, hits[size_t(i)]);
-        contextOf[size_t(i)] = &contexts[size_t(i)].emplace(hits[size_t(i)]);
-        payloads[size_t(i)] = traces[size_t(i)].rs.payload;
-        attributes[size_t(i)] = traces[size_t(i)].rs.committedHit.attributes;
+        callerSections[size_t(i)] = beginInvocation(*hits[i].thread, hits[i]);
+        contextOf[size_t(i)] = &contexts[size_t(i)].emplace(hits[i]);
+        payloads[size_t(i)] = traces[i].rs.payload;
+        attributes[size_t(i)] = traces[i].rs.committedHit.attributes;
     }
     ClosestHitWave shaderWave(contextOf, lanes, &wave, payloads, attributes);
     std::exception_ptr escaped;
@@ -172,8 +173,8 @@ void runClosestHitWave(Wave& wave, const ShaderExport& shader, LaneMask lanes, s
         }
     }
     for (int i : lanes) {
-        LaneTrace& t = traces[size_t(i)];
-        endInvocation(*hits[size_t(i)].thread, callerSections[size_t(i)]);
+        LaneTrace& t = traces[i];
+        endInvocation(*hits[i].thread, callerSections[size_t(i)]);
         if (shaderWave.failure(i)) *t.failure = shaderWave.failure(i);
         else if (escaped && shaderWave.isActive(i)) *t.failure = escaped;
         else t.end();
@@ -185,10 +186,10 @@ void runClosestHitWave(Wave& wave, const ShaderExport& shader, LaneMask lanes, s
 void traceRaysInWave(Wave& wave, const std::array<Invocation*, kMaxWaveWidth>& callers,
                      const TraceRayCall* calls, LaneMask lanes,
                      std::array<std::exception_ptr, kMaxWaveWidth>& failures) {
-    std::array<LaneTrace, kMaxWaveWidth> traces;
+    LaneSlots<LaneTrace> traces;
     LaneMask packet, invoked;
     for (int i : lanes) {
-        LaneTrace& t = traces[size_t(i)];
+        LaneTrace& t = traces.emplace(i);
         t.caller = callers[size_t(i)];
         t.call = &calls[size_t(i)];
         t.failure = &failures[size_t(i)];
@@ -208,8 +209,8 @@ void traceRaysInWave(Wave& wave, const std::array<Invocation*, kMaxWaveWidth>& c
         const MxcsrScope scheduling(wave.schedulerMxcsr);
         for (int i : packet) {
             WaveLane& lane = wave.lanes[size_t(i)];
-            lane.ray = &traces[size_t(i)].rs;
-            lane.site = siteOf(*traces[size_t(i)].caller);
+            lane.ray = &traces[i].rs;
+            lane.site = siteOf(*traces[i].caller);
         }
         traversePacket(wave, packet);
         for (int i : packet) {
@@ -230,29 +231,29 @@ void traceRaysInWave(Wave& wave, const std::array<Invocation*, kMaxWaveWidth>& c
     //   traversed together as the lanes of any wave);
     // - a lane without one (a miss shader, or none: a miss, SKIP_CLOSEST_HIT_SHADER, a NULL record) finishes here, on
     //   the wave's stack: a TraceRay from its miss shader traverses at once (awaitTraversal).
-    std::array<RecordView, kMaxWaveWidth> records;
-    std::array<Invocation, kMaxWaveWidth> hits;
+    LaneSlots<RecordView> records;
+    LaneSlots<Invocation> hits;
     RecordGroups waveHits;
     LaneMask onFibers;
     for (int i : invoked) {
-        LaneTrace& t = traces[size_t(i)];
+        LaneTrace& t = traces[i];
         if (!t.rs.committed) {
             t.finish();
             continue;
         }
         bool runs = false;
         try {
-            runs = prepareClosestHit(*t.caller->thread, t.rs, siteOf(*t.caller), records[size_t(i)], hits[size_t(i)]);
+            runs = prepareClosestHit(*t.caller->thread, t.rs, siteOf(*t.caller), records.emplace(i), hits.emplace(i));
         } catch (...) {
             failures[size_t(i)] = std::current_exception();
             continue;
         }
         if (!runs) {
             t.end();
-        } else if (hits[size_t(i)].shader->waveClosestHit) {
-            waveHits.add(i, hits[size_t(i)].shader, 0);
+        } else if (hits[i].shader->waveClosestHit) {
+            waveHits.add(i, hits[i].shader, 0);
         } else {
-            laneFiber(wave, i).start([&t, &hit = hits[size_t(i)]] { t.closestHit(hit); });  // two pointers
+            laneFiber(wave, i).start([&t, &hit = hits[i]] { t.closestHit(hit); });  // two pointers
             onFibers.set(i);
         }
     }

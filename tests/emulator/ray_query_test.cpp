@@ -423,6 +423,37 @@ TEST(RayQuery, RQ_7_CopiesShareOneStateMachine) {
     EXPECT_TRUE(runQuery(r).diagnostics.empty());
 }
 
+TEST(RayQuery, RQ_7_AQueryMadeAfterAnotherIsGoneStartsFresh) {
+    // Once no handle refers to a query's state, it is kept for the next query its worker thread makes: that query
+    // starts with nothing of the old one (no candidates, commit or Proceed; RayQueryObject, "Counted by the handles").
+    Rig r;
+    oneInstance(r, r.h.triangles(trisAt({-2, 0, 2}), GEOMETRY_FLAG_NONE));  // t = 3, 5, 7
+    declare(r, "RG", {RAY_FLAG_NONE});
+    r.rg = [scene = r.h.scene](ShaderContext& ctx) {
+        RayDesc away = zRay();
+        away.Direction = -away.Direction;  // meets nothing
+        for (int round = 0; round < 3; ++round) {
+            {
+                RayQuery<RAY_FLAG_NONE> a(ctx);
+                a.TraceRayInline(scene, RAY_FLAG_NONE, 0xFF, zRay());
+                ASSERT_TRUE(a.Proceed());
+                ASSERT_TRUE(a.Proceed());  // the triangle at t = 5 waits for the shader
+                a.CommitNonOpaqueTriangleHit();
+                const RayQueryObject copy = a;
+                EXPECT_TRUE(copy.sameQueryAs(a));
+            }
+            RayQuery<RAY_FLAG_NONE> b(ctx);
+            b.TraceRayInline(scene, RAY_FLAG_NONE, 0xFF, away);
+            EXPECT_FALSE(b.Proceed()) << "round " << round << ": the new query met the old one's candidates";
+            EXPECT_EQ(b.CommittedStatus(), COMMITTED_NOTHING) << "round " << round;
+        }
+        RayQuery<RAY_FLAG_NONE> fresh(ctx);
+        fresh.Proceed();  // before its TraceRayInline, whatever the state it may reuse went through: RQ-19
+    };
+    const Diagnostic d = expectDxrError("RQ-19", [&] { runQuery(r); });
+    EXPECT_TRUE(contains(valueOf(d, "state"), "no TraceRayInline")) << d.format();
+}
+
 TEST(RayQuery, RQ_7_AQueryKeepsItsStateAcrossATraceRayWhoseShadersRunQueriesOfTheirOwn) {
     Rig r;
     oneInstance(r, r.h.triangles(trisAt({-2, 0, 2}), GEOMETRY_FLAG_NONE));  // t = 3, 5, 7
