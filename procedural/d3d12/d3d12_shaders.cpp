@@ -1075,25 +1075,35 @@ void InlineAmbientOcclusionCS(ComputeWave& wave, const TraceRayArgumentSet& trac
 template <typename T, typename L>
 void IntersectionShaderOf(IntersectionWave& wave, IntersectionShader shader, const Accuracy& accuracy) {
     [[maybe_unused]] PrecisionScope<L> scope;
+    // PORT: what the lanes of a record group read alike (their record's constants, the attribute element it names,
+    // the scene's time) is read once, by the first lane whose read succeeds (one whose read fails leaves the wave with
+    // its error, as it would alone), in the order a lane alone reads it; each lane reads its own ray and extent.
+    struct GroupInput {
+        PrimitiveInstancePerFrameBuffer aabbAttribute{};
+        uint32_t primitiveType = 0;
+        T elapsedTime = T(0), stepScale = T(1);
+    };
+    GroupInput group;
+    bool groupRead = false;
+    wave.forEachLane([&](int, ShaderContext& ctx) {
+        if (groupRead) return;
+        group.aabbAttribute = primitiveAttributes(ctx);
+        group.primitiveType = aabbCB(ctx).primitiveType;
+        if (shader == IntersectionShader::VolumetricPrimitive) group.elapsedTime = T(sceneCB(ctx).elapsedTime);
+        if (shader == IntersectionShader::SignedDistancePrimitive) group.stepScale = T(materialCB(ctx).stepScale);
+        groupRead = true;
+    });
     struct LaneInput {
-        PrimitiveInstancePerFrameBuffer aabbAttribute;
         math::Ray<T> localRay;
         math::RayExtent<T> extent;
-        uint32_t primitiveType = 0;
-        T elapsedTime, stepScale;
+        T stepScale;
     };
-    const auto in = gatherLanes(wave, [shader](ShaderContext& ctx) {
-        LaneInput l;
-        l.aabbAttribute = primitiveAttributes(ctx);
-        l.localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx, l.aabbAttribute);
-        l.extent = CurrentExtent<T>(ctx);
-        l.primitiveType = aabbCB(ctx).primitiveType;
-        l.elapsedTime = shader == IntersectionShader::VolumetricPrimitive ? T(sceneCB(ctx).elapsedTime) : T(0);
-        l.stepScale = shader == IntersectionShader::SignedDistancePrimitive ? T(materialCB(ctx).stepScale) : T(1);
-        return l;
+    const auto in = gatherLanes(wave, [&group](ShaderContext& ctx) {
+        return LaneInput{GetRayInAABBPrimitiveLocalSpace<T>(ctx, group.aabbAttribute), CurrentExtent<T>(ctx),
+                         group.stepScale};
     });
     if (wave.active().empty()) return;
-    const uint32_t primitiveType = in[size_t(wave.active().lowest())].primitiveType;
+    const uint32_t primitiveType = group.primitiveType;
     // Each lane's hit.
     const std::array<PrimitiveHit<T>, kMaxWaveWidth> hits = [&] {
         if constexpr (math::kIsLanes<L>) {
@@ -1108,8 +1118,8 @@ void IntersectionShaderOf(IntersectionWave& wave, IntersectionShader shader, con
         const math::LiveLanes live(wave.active().bits(), 0);  // duplicated inactive lanes skip libm's calls
         const auto localRay = toLanes<math::Ray<L>>(in, [](const LaneInput& l) { return l.localRay; });
         const auto extent = toLanes<math::RayExtent<L>>(in, [](const LaneInput& l) { return l.extent; });
-        const L elapsedTime = toLanes<L>(in, [](const LaneInput& l) { return l.elapsedTime; });
-        const L stepScale = toLanes<L>(in, [](const LaneInput& l) { return l.stepScale; });
+        const L elapsedTime(group.elapsedTime);
+        const L stepScale(group.stepScale);
         const PrimitiveHit<L> test =
             IntersectPrimitive<L>(shader, primitiveType, localRay, extent, elapsedTime, stepScale, accuracy);
         std::array<PrimitiveHit<T>, kMaxWaveWidth> byLane{};
@@ -1121,7 +1131,7 @@ void IntersectionShaderOf(IntersectionWave& wave, IntersectionShader shader, con
         const PrimitiveHit<T>& hit = hits[size_t(i)];
         if (!hit.hit) return;
         const ProceduralPrimitiveAttributes attr{
-            vec3(NormalToWorld(ctx.ObjectToWorld3x4(), in[size_t(i)].aabbAttribute, hit.normal))};
+            vec3(NormalToWorld(ctx.ObjectToWorld3x4(), group.aabbAttribute, hit.normal))};
         wave.ReportHit(i, float(hit.thit), /*hitKind*/ 0, attr);
     });
 }

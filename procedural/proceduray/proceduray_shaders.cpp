@@ -240,11 +240,16 @@ tvec3<T> HitWorldPosition(const ShaderContext& ctx) {
 
 // The world ray in the AABB's local space through g_instanceBuffer[l_aabbCB.instanceIndex]; the
 // direction is normalised, which is where H1 comes from.
-template <typename T>
-math::Ray<T> GetRayInAABBPrimitiveLocalSpace(const ShaderContext& ctx) {
+// PORT: in two parts, the instance's element (g_instanceBuffer[l_aabbCB.instanceIndex]) and the ray through it, so
+// that the lanes of a record group read the element once (ProceduralWave).
+InstanceBuffer AABBPrimitiveInstance(const ShaderContext& ctx, const PrimitiveInstanceConstantBuffer& l_aabbCB) {
     const GpuVirtualAddress element =
-        ctx.globalRootDescriptor(kInstanceBuffer) + uint64_t(aabbCB(ctx).instanceIndex) * sizeof(InstanceBuffer);
-    const InstanceBuffer attr = ctx.load<InstanceBuffer>(element);
+        ctx.globalRootDescriptor(kInstanceBuffer) + uint64_t(l_aabbCB.instanceIndex) * sizeof(InstanceBuffer);
+    return ctx.load<InstanceBuffer>(element);
+}
+
+template <typename T>
+math::Ray<T> GetRayInAABBPrimitiveLocalSpace(const ShaderContext& ctx, const InstanceBuffer& attr) {
     math::Ray<T> ray;
     ray.origin = tvec3<T>(mul(tvec4<T>(tvec3<T>(ctx.WorldRayOrigin()), T(1)), attr.localSpaceToBottomLevelAS));
     ray.direction = hlsl::normalize(mul3x3(tvec3<T>(ctx.WorldRayDirection()), attr.localSpaceToBottomLevelAS));
@@ -477,50 +482,73 @@ void ClosestHit_Triangle(ClosestHitWave& wave, const TraceRayArgumentSet& traceR
 // march between runs over the lanes at once (WaveLanes<T>; T itself for a group of one lane, withLaneType). Lanes of a record group share its record (primitive
 // type, instance index, step scale).
 
-// What one lane of an intersection shader reads before its march.
-template <typename T>
-struct LaneInput {
-    math::Ray<T> localRay;
-    math::RayExtent<T> extent;
-    SceneConstantBuffer sceneCB;
-    PrimitiveInstanceConstantBuffer aabbCB;
+// What the lanes of a record group read alike: the scene's constants (a global root argument), the record's
+// (l_aabbCB, l_materialCB.stepScale) and the instance element l_aabbCB names.
+struct GroupInput {
+    SceneConstantBuffer sceneCB{};
+    PrimitiveInstanceConstantBuffer aabbCB{};
     float stepScale = 0.0f;
+    InstanceBuffer instance{};
 };
 
-template <typename T>
-LaneInput<T> readLane(const ShaderContext& ctx) {
-    LaneInput<T> in;
-    in.localRay = GetRayInAABBPrimitiveLocalSpace<T>(ctx);
-    in.extent = CurrentExtent<T>(ctx);
-    in.sceneCB = sceneCB(ctx);
+GroupInput readGroup(const ShaderContext& ctx) {
+    GroupInput in;  // in the order a lane alone reads them
     in.aabbCB = aabbCB(ctx);
+    in.instance = AABBPrimitiveInstance(ctx, in.aabbCB);
+    in.sceneCB = sceneCB(ctx);
     in.stepScale = materialCB(ctx).stepScale;
     return in;
 }
 
-// The opening every Proceduray intersection shader shares: each lane reads its input; `if (g_sceneCB.debugFlag) {
-// ReportHit(0, 1, attr); return; }` per lane; the lanes that go on march (and only they call libm: LiveLanes).
+// What one lane of an intersection shader reads of its own before its march.
+template <typename T>
+struct LaneInput {
+    math::Ray<T> localRay;
+    math::RayExtent<T> extent;
+};
+
+// The opening every Proceduray intersection shader shares: the group's input, then each lane's; `if
+// (g_sceneCB.debugFlag) { ReportHit(0, 1, attr); return; }` per lane; the lanes that go on march (and only they call
+// libm: LiveLanes).
+// PORT: the lanes of a record group share their record and the scene's constants, so what they read alike is read
+// once, by the first lane whose read succeeds (a lane whose read fails leaves the wave with its error, as it would
+// alone; all of them do for a broken binding), and each lane reads only its ray and extent.
 template <typename T>
 struct ProceduralWave {
-    // The lanes' inputs are read in place (a wave's are about 4 KB), then the debug lanes report their hit.
     explicit ProceduralWave(IntersectionWave& wave)
-        : in(gatherLanes(wave, [](ShaderContext& ctx) { return readLane<T>(ctx); })),
-          marching(openLanes(wave, in)),
+        : shared(readShared(wave)),
+          in(gatherLanes(wave,
+                         [this](ShaderContext& ctx) {
+                             return LaneInput<T>{GetRayInAABBPrimitiveLocalSpace<T>(ctx, shared.instance),
+                                                 CurrentExtent<T>(ctx)};
+                         })),
+          marching(openLanes(wave, shared)),
           live(marching.bits(), 0) {}
+    GroupInput shared;
     std::array<LaneInput<T>, kMaxWaveWidth> in;
     LaneMask marching;
     math::LiveLanes live;
-    static LaneMask openLanes(IntersectionWave& wave, const std::array<LaneInput<T>, kMaxWaveWidth>& in) {
+    static GroupInput readShared(IntersectionWave& wave) {
+        GroupInput shared;
+        bool read = false;
+        wave.forEachLane([&](int, ShaderContext& ctx) {
+            if (read) return;
+            shared = readGroup(ctx);
+            read = true;
+        });
+        return shared;
+    }
+    static LaneMask openLanes(IntersectionWave& wave, const GroupInput& shared) {
         LaneMask marching;
         for (int i = 0; i < kMaxWaveWidth; ++i) {
             if (!wave.isActive(i)) continue;
-            if (in[size_t(i)].sceneCB.debugFlag) wave.ReportHit(i, 0.0f, 1, kInitialAttributes);
+            if (shared.sceneCB.debugFlag) wave.ReportHit(i, 0.0f, 1, kInitialAttributes);
             else marching.set(i);
         }
         return marching;
     }
-    // What the group's lanes share (its record and constants): the first marching lane's.
-    const LaneInput<T>& group() const { return in[size_t(marching.lowest())]; }
+    // What the group's lanes share (its record and constants).
+    const GroupInput& group() const { return shared; }
     template <typename L>
     math::Ray<L> localRay() const {
         return toLanes<math::Ray<L>>(in, [](const LaneInput<T>& l) { return l.localRay; });
@@ -554,7 +582,7 @@ void Intersection_Pacman(IntersectionWave& wave, const Accuracy& accuracy) {
     const auto& in = lanes.in;
     const LaneMask marching = lanes.marching;
     if (marching.empty()) return;
-    const LaneInput<T>& group = lanes.group();
+    const GroupInput& group = lanes.group();
     const auto primitiveType = SignedDistancePrimitive(group.aabbCB.primitiveType);
 
     const L mouth = L(math::pacman::PacmanMouthInterpolant(T(group.sceneCB.elapsedTime)));
@@ -573,8 +601,8 @@ void Intersection_Pacman(IntersectionWave& wave, const Accuracy& accuracy) {
                 math::RaySignedDistancePrimitiveTestQueue<L>(rays, count, sdf, params, out);
             });
     } else {
-        primitiveTest[size_t(marching.lowest())] =
-            math::RaySignedDistancePrimitiveTest(group.localRay, group.extent, sdf, params);  // a group of one lane
+        const LaneInput<T>& ray = in[size_t(marching.lowest())];  // a group of one lane
+        primitiveTest[size_t(marching.lowest())] = math::RaySignedDistancePrimitiveTest(ray.localRay, ray.extent, sdf, params);
     }
 
     // H1: thit is in normalised local units, compared with and reported as if it were world t.
@@ -627,7 +655,7 @@ void Intersection_Mandelbulb(IntersectionWave& wave, const Accuracy& accuracy) {
     const auto& in = lanes.in;
     const LaneMask marching = lanes.marching;
     if (marching.empty()) return;
-    const LaneInput<T>& group = lanes.group();
+    const GroupInput& group = lanes.group();
 
     // The step count animates with time and the procedural instance ordinal (not InstanceIndex()).
     // l_materialCB.stepScale is passed by the HLSL but never used, so it is not read here.
@@ -646,8 +674,9 @@ void Intersection_Mandelbulb(IntersectionWave& wave, const Accuracy& accuracy) {
                 math::mandelbulb::MandelbulbDistanceQueue<L>(ro, rd, count, iMax, out, params);
             });
     } else {
+        const LaneInput<T>& ray = in[size_t(marching.lowest())];  // a group of one lane
         primitiveTest[size_t(marching.lowest())] =
-            math::mandelbulb::MandelbulbDistance(group.localRay.origin, group.localRay.direction, iMax, params);
+            math::mandelbulb::MandelbulbDistance(ray.localRay.origin, ray.localRay.direction, iMax, params);
     }
 
     wave.forEachLane([&](int i, ShaderContext& ctx) {
@@ -707,7 +736,7 @@ void Intersection_Julia(IntersectionWave& wave, const Accuracy& accuracy) {
                 math::julia::JuliaDistanceQueue<L>(ro, rd, count, out, juliaParams<T>(accuracy));
             });
     } else {
-        const LaneInput<T>& ray = lanes.group();  // a group of one lane
+        const LaneInput<T>& ray = in[size_t(marching.lowest())];  // a group of one lane
         primitiveTest[size_t(marching.lowest())] =
             math::julia::JuliaDistance(ray.localRay.origin, ray.localRay.direction, juliaParams<T>(accuracy));
     }
