@@ -10,6 +10,7 @@
 #include "emulator/ray_generation_wave.h"
 #include "emulator/root_signature.h"
 #include "procedural/math/hlsl.h"
+#include "procedural/wave_shader.h"
 
 namespace refray::procedural {
 
@@ -115,7 +116,7 @@ glm::vec<4, T> TracePayloadColor(dxr::ShaderContext& ctx, MakeCall makeCall) {
     return glm::vec<4, T>(payload.color);
 }
 
-// The camera and output texture a ray generation shader reads: what CameraRaygen's `camera` gives for a lane.
+// The camera a ray generation shader reads: what CameraRaygen's `camera` gives (the scene's constants).
 template <typename T>
 struct CameraSetup {
     glm::vec<3, T> cameraPosition;
@@ -130,11 +131,15 @@ struct CameraSetup {
 // `outputTable`. Lane by lane it is the HLSL's code.
 // PORT: the texture stores floats; the R8G8B8A8_UNORM conversion (clamp, round, NaN -> 0) happens when the image is
 // written out (H20).
+// PORT: the camera (the scene's constants) and the output texture are global root arguments, read once between the
+// lanes (WaveShared, procedural/wave_shader.h).
 template <typename T, class Payload, class Camera, class RadianceCall>
 void CameraRaygen(dxr::RayGenerationWave& wave, uint32_t outputTable, Camera camera, RadianceCall radianceCall) {
+    WaveShared<CameraSetup<T>> shared;
+    WaveShared<Image*> output;
     wave.TraceRayInEachLane<Payload>(
         [&](dxr::ShaderContext& ctx, Payload& rayPayload, dxr::TraceRayCall& call) {
-            const CameraSetup<T> setup = camera(ctx);
+            const CameraSetup<T>& setup = shared.get(ctx, camera);
             glm::vec<3, T> origin, direction;
             GenerateCameraRay(uvec2(ctx.DispatchRaysIndex()), uvec2(ctx.DispatchRaysDimensions()),
                               setup.cameraPosition, setup.projectionToWorld, origin, direction);
@@ -144,7 +149,10 @@ void CameraRaygen(dxr::RayGenerationWave& wave, uint32_t outputTable, Camera cam
         [&](dxr::ShaderContext& ctx, const Payload& rayPayload, bool traced) {
             const uvec3 index = ctx.DispatchRaysIndex();
             const glm::vec<4, T> color = traced ? glm::vec<4, T>(rayPayload.color) : glm::vec<4, T>(T(0));
-            ctx.rwTexture2D(ctx.globalDescriptorTable(outputTable)).at(index.x, index.y) = vec4(color);
+            Image* target = output.get(ctx, [outputTable](const dxr::ShaderContext& lane) {
+                return &lane.rwTexture2D(lane.globalDescriptorTable(outputTable));
+            });
+            target->at(index.x, index.y) = vec4(color);
         });
 }
 

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <type_traits>
 
 #include "emulator/intersection_wave.h"
@@ -24,6 +25,23 @@ inline constexpr int kWaveLanes = 8;
 // The lane type of a wave shader whose one-ray math runs in T.
 template <typename T>
 using WaveLanes = math::Lanes<T, kWaveLanes>;
+
+// A value every lane of a wave reads alike, such as a global root argument (the scene's constants, the output
+// texture): the first lane whose read succeeds reads it, and the lanes after it take that copy, each at the point
+// where its code reads it (a lane whose read fails leaves the wave with its error, as it would alone).
+// PORT: where a wave shader holds one, the HLSL reads the value in every lane.
+template <class V>
+class WaveShared {
+public:
+    template <class Read>
+    const V& get(dxr::ShaderContext& ctx, Read&& read) {
+        if (!value_) value_ = read(ctx);
+        return *value_;
+    }
+
+private:
+    std::optional<V> value_;
+};
 
 // f(lane's ShaderContext) for every active lane of `wave`, in lane order; an inactive lane gets the first active
 // lane's value, so that the math over every lane runs on sane values (a NaN ray would keep a march running). A lane

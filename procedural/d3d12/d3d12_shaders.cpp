@@ -766,9 +766,10 @@ void SampleClosestHit(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay,
     [[maybe_unused]] PrecisionScope<T> scope;
     const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
     std::array<ClosestHitLane<T>, kMaxWaveWidth> lanes;
+    WaveShared<SceneConstantBuffer> scene;  // PORT: g_sceneCB, read once between the lanes
     // Up to the shadow ray: the lane's constants, normal, hit position and the direction to the light.
     const auto openLane = [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l) {
-        l.sceneCB = sceneCB(ctx);
+        l.sceneCB = scene.get(ctx, sceneCB);
         l.materialCB = materialCB(ctx);
         open(ctx, l, wave.attributes<Attributes>(i));
         l.hitPosition = HitWorldPosition<T>(ctx);
@@ -1019,14 +1020,19 @@ void InlineAmbientOcclusionCS(ComputeWave& wave, const TraceRayArgumentSet& trac
     };
     std::array<Lane, kMaxWaveWidth> lanes;
     LaneMask inside;  // threads inside the render target
+    // PORT: the render target and g_sceneCB are read once between the lanes (WaveShared).
+    WaveShared<Image*> target;
+    WaveShared<SceneConstantBuffer> scene;
     wave.forEachLane([&](int i, ShaderContext& ctx) {
         Lane& l = lanes[size_t(i)];
         const uvec3 id = ctx.DispatchThreadID();
-        l.target = &ctx.rwTexture2D(ctx.globalDescriptorTable(kOutputView));
+        l.target = target.get(ctx, [](const ShaderContext& lane) {
+            return &lane.rwTexture2D(lane.globalDescriptorTable(kOutputView));
+        });
         const uint32_t width = l.target->width(), height = l.target->height();  // g_renderTarget.GetDimensions
         if (id.x >= width || id.y >= height) return;
         l.id = uvec2(id);
-        const SceneConstantBuffer g_sceneCB = sceneCB(ctx);
+        const SceneConstantBuffer& g_sceneCB = scene.get(ctx, sceneCB);
         GenerateCameraRay(l.id, uvec2(width, height), tvec3<T>(vec3(g_sceneCB.cameraPosition)),
                           g_sceneCB.projectionToWorld, l.origin, l.rayDir);
         PrimaryQuery(l.primary, ctx, traceRay, accuracy, l.origin, l.rayDir, variant);

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstring>
+#include <optional>
 
 #include "emulator/closest_hit_wave.h"
 #include "emulator/intersection_wave.h"
@@ -331,6 +332,7 @@ tvec4<T> ReflectedColor(const tvec3<T>& D, const tvec3<T>& normal, T reflectance
 // What a closest hit's lane carries from one TraceRay to the next.
 template <typename T>
 struct ClosestHitLane {
+    WaveShared<SceneConstantBuffer>* scene = nullptr;  // g_sceneCB, which the wave's lanes read once between them
     bool returned = false;  // the shader returned early (a debug colour)
     SceneConstantBuffer sceneCB;
     PrimitiveConstantBuffer materialCB;
@@ -370,9 +372,11 @@ template <typename T, class Attributes, class Open, class Close>
 void LitClosestHit(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay, uint32_t maxDepth, const Effects& effects,
                    bool shadows, Open open, Close close) {
     [[maybe_unused]] PrecisionScope<T> scope;
+    WaveShared<SceneConstantBuffer> scene;  // PORT: g_sceneCB, read once between the lanes
     wave.TraceRaysInSteps<ClosestHitLane<T>>(
         [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall& call) {
             RayPayload& rayPayload = wave.payload<RayPayload>(i);
+            l.scene = &scene;
             l.returned = !open(ctx, l, rayPayload, wave.attributes<Attributes>(i));
             if (l.returned || !shadows) return false;
             return l.shadowTraced = ShadowRayTowardsLightCall<T>(ctx, traceRay, maxDepth, effects, l.sceneCB,
@@ -453,7 +457,7 @@ void ClosestHit_Triangle(ClosestHitWave& wave, const TraceRayArgumentSet& traceR
     LitClosestHit<T, BuiltInTriangleIntersectionAttributes>(
         wave, traceRay, maxDepth, effects, /*shadows*/ true,
         [](ShaderContext& ctx, ClosestHitLane<T>& l, RayPayload& rayPayload, const BuiltInTriangleIntersectionAttributes&) {
-            l.sceneCB = sceneCB(ctx);
+            l.sceneCB = l.scene->get(ctx, sceneCB);
             if (l.sceneCB.debugFlag) {
                 rayPayload.color = vec4(0.0f, 0.0f, 1.0f, 0.0f);
                 return false;
@@ -631,7 +635,7 @@ void ClosestHit_Pacman(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay
                 rayPayload.color = vec4(0.0f, 0.0f, 1.0f, 0.0f);
                 return false;
             }
-            l.sceneCB = sceneCB(ctx);
+            l.sceneCB = l.scene->get(ctx, sceneCB);
             l.materialCB = materialCB(ctx);
             l.normal = tvec3<T>(attr.normal);
             l.albedo = tvec4<T>(l.materialCB.albedo);
@@ -765,7 +769,7 @@ void ClosestHit_Julia(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay,
         wave, traceRay, maxDepth, effects, /*shadows*/ false,
         [maxDepth](ShaderContext& ctx, ClosestHitLane<T>& l, RayPayload& rayPayload,
                    const ProceduralPrimitiveAttributes& attr) {
-            l.sceneCB = sceneCB(ctx);
+            l.sceneCB = l.scene->get(ctx, sceneCB);
             if (l.sceneCB.debugFlag) {
                 rayPayload.color = vec4(1.0f, 0.0f, 0.0f, 0.0f);
                 return false;
