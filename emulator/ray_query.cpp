@@ -272,11 +272,8 @@ RayQueryObject& RayQueryObject::operator=(const RayQueryObject& other) {
 RayQueryObject::~RayQueryObject() { releaseQueryState(state_); }
 
 RayQueryObject::RayQueryObject(ShaderContext& ctx, uint32_t templateRayFlags, uint32_t rayQueryFlags)
-    : state_(takeQueryState()) {
-    state_->handles = 1;
-    state_->inv = &ctx.inv_;
-    state_->templateFlags = templateRayFlags;
-    state_->rayQueryFlags = rayQueryFlags;
+    : state_(nullptr) {
+    // The checks first: a constructor that throws leaves no handle to give the state back.
     ctx.requireLive("RayQuery");
     const ShaderExport* shader = ctx.inv_.shader;
     if (shader && std::find(shader->rayQueryFlags.begin(), shader->rayQueryFlags.end(), templateRayFlags) ==
@@ -284,6 +281,11 @@ RayQueryObject::RayQueryObject(ShaderContext& ctx, uint32_t templateRayFlags, ui
         detail::stageError(ctx.inv_, "RQ-2",
                            "shader '" + shader->name + "' makes a RayQuery<" + rayFlagsToString(templateRayFlags) +
                                "> that its export does not declare (ShaderLibrary::declareRayQueries)");
+    state_ = takeQueryState();
+    state_->handles = 1;
+    state_->inv = &ctx.inv_;
+    state_->templateFlags = templateRayFlags;
+    state_->rayQueryFlags = rayQueryFlags;
 }
 
 void RayQueryObject::TraceRayInline(GpuVirtualAddress as, uint32_t rayFlags, uint32_t mask, const RayDesc& ray) {
