@@ -38,10 +38,22 @@ public:
         if (!value_) value_ = read(ctx);
         return *value_;
     }
+    // What a lane read, or V{} when none has.
+    V valueOrDefault() const { return value_.value_or(V{}); }
 
 private:
     std::optional<V> value_;
 };
+
+// `read(ctx)` of an intersection record group's lanes, which all read it alike (their record's constants, a global
+// root argument): read by the first lane whose read succeeds, through WaveShared (a lane whose read fails leaves the
+// wave with its error); V{} when every lane's fails.
+template <class Read>
+auto readByTheGroup(dxr::IntersectionWave& wave, Read&& read) {
+    WaveShared<std::decay_t<decltype(read(wave.lane(0)))>> shared;
+    wave.forEachLane([&](int, dxr::ShaderContext& ctx) { shared.get(ctx, read); });
+    return shared.valueOrDefault();
+}
 
 // f(lane's ShaderContext) for every active lane of `wave`, in lane order; an inactive lane gets the first active
 // lane's value, so that the math over every lane runs on sane values (a NaN ray would keep a march running). A lane

@@ -1089,24 +1089,20 @@ void IntersectionShaderOf(IntersectionWave& wave, IntersectionShader shader, con
         uint32_t primitiveType = 0;
         T elapsedTime = T(0), stepScale = T(1);
     };
-    GroupInput group;
-    bool groupRead = false;
-    wave.forEachLane([&](int, ShaderContext& ctx) {
-        if (groupRead) return;
-        group.aabbAttribute = primitiveAttributes(ctx);
-        group.primitiveType = aabbCB(ctx).primitiveType;
-        if (shader == IntersectionShader::VolumetricPrimitive) group.elapsedTime = T(sceneCB(ctx).elapsedTime);
-        if (shader == IntersectionShader::SignedDistancePrimitive) group.stepScale = T(materialCB(ctx).stepScale);
-        groupRead = true;
+    const GroupInput group = readByTheGroup(wave, [shader](const ShaderContext& ctx) {
+        GroupInput g;
+        g.aabbAttribute = primitiveAttributes(ctx);
+        g.primitiveType = aabbCB(ctx).primitiveType;
+        if (shader == IntersectionShader::VolumetricPrimitive) g.elapsedTime = T(sceneCB(ctx).elapsedTime);
+        if (shader == IntersectionShader::SignedDistancePrimitive) g.stepScale = T(materialCB(ctx).stepScale);
+        return g;
     });
     struct LaneInput {
         math::Ray<T> localRay;
         math::RayExtent<T> extent;
-        T stepScale;
     };
     const auto in = gatherLanes(wave, [&group](ShaderContext& ctx) {
-        return LaneInput{GetRayInAABBPrimitiveLocalSpace<T>(ctx, group.aabbAttribute), CurrentExtent<T>(ctx),
-                         group.stepScale};
+        return LaneInput{GetRayInAABBPrimitiveLocalSpace<T>(ctx, group.aabbAttribute), CurrentExtent<T>(ctx)};
     });
     if (wave.active().empty()) return;
     const uint32_t primitiveType = group.primitiveType;
@@ -1116,7 +1112,9 @@ void IntersectionShaderOf(IntersectionWave& wave, IntersectionShader shader, con
             if (shader == IntersectionShader::SignedDistancePrimitive)  // all the group's lanes through one queue
                 return throughQueue<PrimitiveHit<T>>(
                     wave.active(), in,
-                    [](const LaneInput& l) { return math::SphereTraceRay<T>{l.localRay, l.extent, l.stepScale}; },
+                    [&group](const LaneInput& l) {
+                        return math::SphereTraceRay<T>{l.localRay, l.extent, group.stepScale};
+                    },
                     [&](const math::SphereTraceRay<T>* rays, int count, PrimitiveHit<T>* out) {
                         SignedDistanceQueue(primitiveType, accuracy, rays, count, out);
                     });

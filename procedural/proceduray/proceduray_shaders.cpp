@@ -4,7 +4,6 @@
 
 #include <array>
 #include <cstring>
-#include <optional>
 
 #include "emulator/closest_hit_wave.h"
 #include "emulator/intersection_wave.h"
@@ -520,7 +519,7 @@ struct LaneInput {
 template <typename T>
 struct ProceduralWave {
     explicit ProceduralWave(IntersectionWave& wave)
-        : shared(readShared(wave)),
+        : shared(readByTheGroup(wave, readGroup)),
           in(gatherLanes(wave,
                          [this](ShaderContext& ctx) {
                              return LaneInput<T>{GetRayInAABBPrimitiveLocalSpace<T>(ctx, shared.instance),
@@ -532,16 +531,6 @@ struct ProceduralWave {
     std::array<LaneInput<T>, kMaxWaveWidth> in;
     LaneMask marching;
     math::LiveLanes live;
-    static GroupInput readShared(IntersectionWave& wave) {
-        GroupInput shared;
-        bool read = false;
-        wave.forEachLane([&](int, ShaderContext& ctx) {
-            if (read) return;
-            shared = readGroup(ctx);
-            read = true;
-        });
-        return shared;
-    }
     static LaneMask openLanes(IntersectionWave& wave, const GroupInput& shared) {
         LaneMask marching;
         for (int i = 0; i < kMaxWaveWidth; ++i) {
