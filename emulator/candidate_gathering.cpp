@@ -82,8 +82,8 @@ void prepare(GatherRay& ray, std::vector<Candidate>& out, GatherMode mode) {
     const RayState& rs = *ray.rs;
     const DispatchState& ds = *ts.dispatch;
     out.clear();
+    // Every field set in place (a request assigned from a temporary was copied across its narrow stores).
     GatherRequest& gather = ray.request;
-    gather = GatherRequest();
     gather.tlas = rs.tlas;
     gather.origin = rs.ray.Origin;
     gather.direction = rs.ray.Direction;

@@ -24,11 +24,16 @@ namespace {
     observer(ts)->onEvent(e);
 }
 
-void commit(const ThreadState& ts, RayState& rs, const HitInfo& hit) {  // TRV-4 step 4
-    if (observer(ts)) emitCommit(ts, rs, hit);
+// TRV-4 step 4 for the hit already written in rs.committedHit.
+void commitInPlace(const ThreadState& ts, RayState& rs) {
+    if (observer(ts)) emitCommit(ts, rs, rs.committedHit);
     rs.committed = true;
+    rs.tCurrent = rs.committedHit.t;
+}
+
+void commit(const ThreadState& ts, RayState& rs, const HitInfo& hit) {  // TRV-4 step 4
     rs.committedHit = hit;
-    rs.tCurrent = hit.t;
+    commitInPlace(ts, rs);
 }
 
 enum class AnyHitOutcome { Accept, Ignore, AcceptAndEnd };
@@ -158,21 +163,34 @@ void processTriangle(ThreadState& ts, RayState& rs, const Candidate& c, const Si
         return;  // FLAG-11
     }
 
+    // The hit, field by field. An opaque triangle commits at once (OPQ-3: no any-hit shader), so its hit is written
+    // where the commit keeps it: a HitInfo put together on the stack and copied was read back with wide loads across
+    // its narrow stores (a store-forwarding stall per commit).
+    const auto fill = [&](HitInfo& hit) {
+        hit.instance = &inst;
+        hit.instanceIndex = c.instanceIndex;
+        hit.geometryIndex = c.geometryIndex;
+        hit.primitiveIndex = c.primitiveIndex;
+        hit.hitKind = front ? HIT_KIND_TRIANGLE_FRONT_FACE : HIT_KIND_TRIANGLE_BACK_FACE;  // FACE-4
+        hit.t = c.t;
+        hit.objectRayOrigin = c.objectRayOrigin;
+        hit.objectRayDirection = c.objectRayDirection;
+        const BuiltInTriangleIntersectionAttributes attributes{c.barycentrics};
+        hit.attributeType = typeTag<BuiltInTriangleIntersectionAttributes>();
+        std::memset(hit.attributes, 0, sizeof hit.attributes);
+        std::memcpy(hit.attributes, &attributes, sizeof attributes);
+    };
+    if (opaque) {
+        fill(rs.committedHit);
+        commitInPlace(ts, rs);
+        if (rs.effectiveFlags & RAY_FLAG_ACCEPT_FIRST_HIT_AND_END_SEARCH) rs.searchEnded = true;  // FLAG-8
+        return;
+    }
     HitInfo hit;
-    hit.instance = &inst;
-    hit.instanceIndex = c.instanceIndex;
-    hit.geometryIndex = c.geometryIndex;
-    hit.primitiveIndex = c.primitiveIndex;
-    hit.hitKind = front ? HIT_KIND_TRIANGLE_FRONT_FACE : HIT_KIND_TRIANGLE_BACK_FACE;  // FACE-4
-    hit.t = c.t;
-    hit.objectRayOrigin = c.objectRayOrigin;
-    hit.objectRayDirection = c.objectRayDirection;
-    const BuiltInTriangleIntersectionAttributes attributes{c.barycentrics};
-    hit.attributeType = typeTag<BuiltInTriangleIntersectionAttributes>();
-    std::memcpy(hit.attributes, &attributes, sizeof attributes);
+    fill(hit);
 
     bool endSearch = false;
-    if (!opaque) {  // OPQ-3: the record is needed only to find an AHS (IDX-12)
+    {  // OPQ-3: the record is needed only to find an AHS (IDX-12)
         RecordView record;
         if (lookupHitGroupRecord(ts, site, rs, hit, GeometryType::Triangles, record) && record.entry &&
             record.entry->anyHit) {
@@ -201,22 +219,26 @@ bool prepareIntersection(ThreadState& ts, RayState& rs, const Candidate& c, cons
         return false;  // FLAG-11: before the IS
     }
 
-    box = HitInfo();
+    // Field by field in place (a HitInfo() assigned was copied with wide loads across its narrow stores: a
+    // store-forwarding stall per box). The lookup writes the whole record.
     box.instance = &inst;
     box.instanceIndex = c.instanceIndex;
     box.geometryIndex = c.geometryIndex;
     box.primitiveIndex = c.primitiveIndex;
+    box.hitKind = 0;
+    box.t = 0.0f;
     box.objectRayOrigin = c.objectRayOrigin;
     box.objectRayDirection = c.objectRayDirection;
+    std::memset(box.attributes, 0, sizeof box.attributes);
+    box.attributeType = TypeTag();
 
-    record = RecordView();
     if (!lookupHitGroupRecord(ts, site, rs, box, GeometryType::ProceduralPrimitiveAABBs, record)) return false;
     if (!record.entry) {  // OPQ-4: a NULL hit group has no IS, so no hit
         if (observer(ts)) emitSkipped(ts, rs, "NULL hit group: no intersection shader, no hit (OPQ-4)");
         return false;
     }
 
-    inv = invocation(ts, ShaderStage::Intersection, record.entry->intersection, &record, rs.depth, &rs, &box);
+    setInvocation(inv, ts, ShaderStage::Intersection, record.entry->intersection, &record, rs.depth, &rs, &box);
     inv.candidateOpaque = opaque;
     checkGlobalSignature(ts, siteOf(inv), *record.entry);
     return true;

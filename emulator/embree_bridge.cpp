@@ -121,7 +121,9 @@ void boundsCallback(const RTCBoundsFunctionArguments* args) {
     enlarge(b);
 }
 
-// refray's exact test of one primitive Embree reports: the candidate, or nothing if the ray misses it.
+// refray's exact test of one primitive Embree reports: the candidate, or nothing if the ray misses it. `c` arrives
+// value-initialised (in place in the request's list: a candidate put together on the stack and copied out was read
+// back with wide loads across its narrow stores, a store-forwarding stall per candidate).
 bool exactCandidate(RayGather& gather, uint32_t instanceIndex, void* geometryUserPtr, uint32_t prim, Candidate& c) {
     const GatherRequest& req = *gather.request;
     const auto* user = static_cast<const UserGeometry*>(geometryUserPtr);
@@ -130,31 +132,40 @@ bool exactCandidate(RayGather& gather, uint32_t instanceIndex, void* geometryUse
     const bool triangles = g.type == GeometryType::Triangles;
     if (triangles ? req.skipTriangles : req.skipProcedural) return false;
 
-    // refray's own object-space ray (TRV-8): the exact inverse, not Embree's; once per instance met.
+    // refray's own object-space ray (TRV-8): the exact inverse, not Embree's; once per instance met. Kept in
+    // registers on the way to the candidate (the same stall, on the gather's copy).
+    vec3 objectOrigin, objectDirection;
     if (gather.objectRayInstance != instanceIndex) {
         const BuiltInstance& inst = req.tlas->instances()[instanceIndex];
+        objectOrigin = inst.worldToObject.transformPoint(req.origin);
+        objectDirection = inst.worldToObject.transformVector(req.direction);
         gather.objectRayInstance = instanceIndex;
-        gather.objectRayOrigin = inst.worldToObject.transformPoint(req.origin);
-        gather.objectRayDirection = inst.worldToObject.transformVector(req.direction);
+        gather.objectRayOrigin = objectOrigin;
+        gather.objectRayDirection = objectDirection;
+    } else {
+        objectOrigin = gather.objectRayOrigin;
+        objectDirection = gather.objectRayDirection;
     }
     c.instanceIndex = instanceIndex;
     c.geometryIndex = user->geometryIndex;
     c.primitiveIndex = prim;
-    c.objectRayOrigin = gather.objectRayOrigin;
-    c.objectRayDirection = gather.objectRayDirection;
+    c.objectRayOrigin = objectOrigin;
+    c.objectRayDirection = objectDirection;
 
     if (triangles) {
         const vec3* v = &g.triangleVertices[size_t(prim) * 3];
-        auto hit = intersectTriangle(c.objectRayOrigin, c.objectRayDirection, v[0], v[1], v[2], req.alternateEdgeRule);
-        if (!hit || !(hit->t >= req.tMin && hit->t <= req.tMax)) return false;
-        c.t = c.key = hit->t;
-        c.barycentrics = hit->barycentrics;
+        TriangleIntersection hit;
+        if (!intersectTriangle(objectOrigin, objectDirection, v[0], v[1], v[2], req.alternateEdgeRule, hit) ||
+            !(hit.t >= req.tMin && hit.t <= req.tMax))
+            return false;
+        c.t = c.key = hit.t;
+        c.barycentrics = hit.barycentrics;
         c.procedural = false;
     } else {
-        auto slab = intersectAABB(c.objectRayOrigin, c.objectRayDirection, g.aabbs[prim], req.tMin, req.tMax);
-        if (!slab) return false;
+        SlabInterval slab;
+        if (!intersectAABB(objectOrigin, objectDirection, g.aabbs[prim], req.tMin, req.tMax, slab)) return false;
         c.procedural = true;
-        c.key = slab->tEnter;
+        c.key = slab.tEnter;
     }
     return true;
 }
@@ -162,16 +173,22 @@ bool exactCandidate(RayGather& gather, uint32_t instanceIndex, void* geometryUse
 // All and Closest: collect. Closest also shrinks Embree's tfar to the nearest triangle sure to commit.
 void gatherPrimitive(RayGather& gather, uint32_t instanceIndex, void* geometryUserPtr, uint32_t prim, float& tfar) {
     const GatherRequest& req = *gather.request;
-    Candidate c;
-    if (!exactCandidate(gather, instanceIndex, geometryUserPtr, prim, c)) return;
+    std::vector<Candidate>& out = *req.out;
+    Candidate& c = out.emplace_back();
+    if (!exactCandidate(gather, instanceIndex, geometryUserPtr, prim, c)) {
+        out.pop_back();
+        return;
+    }
     if (req.mode == GatherMode::Closest) {
-        if (c.key > gather.nearestCommit) return;  // the ordered loop would skip it (TRV-2)
+        if (c.key > gather.nearestCommit) {  // the ordered loop would skip it (TRV-2)
+            out.pop_back();
+            return;
+        }
         if (!c.procedural && req.tMin < c.t && c.t < req.tMax && req.commitsSurely(req.user, c)) {
             gather.nearestCommit = c.t;
             tfar = widenedFar(c.t);
         }
     }
-    req.out->push_back(c);
 }
 
 // Embree swallows exceptions, so the callbacks catch everything, stop the ray's traversal and leave the error

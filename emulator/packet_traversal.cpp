@@ -101,7 +101,7 @@ void traversePacket(Wave& wave, LaneMask lanes) {
     for (int i : lanes) {
         WaveLane& lane = wave.lanes[size_t(i)];
         laneOf[count] = i;
-        gathers[count++] = GatherRay{&lane.ts, lane.ray, &lane.site, {}, nullptr};
+        setGatherRay(gathers[count++], lane.ts, *lane.ray, lane.site);
     }
     gatherOrderedCandidates(std::span(gathers.data(), count));
     LaneMask running;

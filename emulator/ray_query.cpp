@@ -110,6 +110,7 @@ enum class SpirvUndefined : uint8_t { ProceedAfterFalse, AbortWithoutCandidate, 
 
 void spirvNote(const RayQueryState& q, SpirvUndefined kind, const char* rule, const char* what) {
     ThreadState& ts = threadOf(q);
+    if (countRepeatedNote(ts, ts.queryNotes[size_t(kind)])) return;  // most calls: no site to build
     note(ts, siteOf(*q.inv), ts.queryNotes[size_t(kind)], [&] {
         return Diagnostic(DiagnosticBuilder(rule,
                                             std::string(what) + ": defined in DXR, undefined in SPIR-V (a Vulkan port "
@@ -144,8 +145,9 @@ void emitQuerySkip(const RayQueryState& q, const QueryHit& h, std::string_view w
     observer(threadOf(q))->onEvent(e);
 }
 
-void commit(RayQueryState& q, const QueryHit& hit, uint32_t status, std::string_view how) {
-    q.committed = hit;
+// The commit of the hit already in q.committed.
+void commitInPlace(RayQueryState& q, uint32_t status, std::string_view how) {
+    const QueryHit& hit = q.committed;
     q.status = status;
     q.rs.tCurrent = hit.t;
     threadOf(q).stats.queryCommits++;
@@ -160,8 +162,14 @@ void commit(RayQueryState& q, const QueryHit& hit, uint32_t status, std::string_
     }
 }
 
-QueryHit hitOf(const RayState& rs, const Candidate& c) {
-    QueryHit h;
+void commit(RayQueryState& q, const QueryHit& hit, uint32_t status, std::string_view how) {
+    q.committed = hit;
+    commitInPlace(q, status, how);
+}
+
+// `h` made the hit of candidate `c`, field by field in place: a QueryHit put together on the stack and copied was
+// read back with wide loads across its narrow stores (a store-forwarding stall per candidate).
+void setHitOf(QueryHit& h, const RayState& rs, const Candidate& c) {
     h.instance = &rs.tlas->instances()[c.instanceIndex];
     h.instanceIndex = c.instanceIndex;
     h.geometryIndex = c.geometryIndex;
@@ -169,9 +177,10 @@ QueryHit hitOf(const RayState& rs, const Candidate& c) {
     h.procedural = c.procedural;
     h.t = c.procedural ? c.key : c.t;
     h.barycentrics = c.barycentrics;
+    h.frontFace = false;
+    h.nonOpaque = false;
     h.objectRayOrigin = c.objectRayOrigin;
     h.objectRayDirection = c.objectRayDirection;
-    return h;
 }
 
 // The next candidate that needs the shader, committing opaque triangles on the way (RQ-14); false at the end.
@@ -180,7 +189,8 @@ bool advance(RayQueryState& q) {
     RayState& rs = q.rs;
     while (q.next < q.candidates.size() && !q.searchEnded) {
         const Candidate& c = q.candidates[q.next++];
-        QueryHit h = hitOf(rs, c);
+        QueryHit& h = q.candidate;  // the candidate a TRUE Proceed shows; a skipped one is overwritten
+        setHitOf(h, rs, c);
         if (observer(ts)) {
             TraceEvent e = queryEvent(q, TraceEvent::Kind::Candidate);
             setQueryHit(e, h);
@@ -206,7 +216,9 @@ bool advance(RayQueryState& q) {
                 continue;
             }
             if (opaque) {  // RQ-14: committed by the system, never seen by the shader
-                commit(q, h, COMMITTED_TRIANGLE_HIT, "opaque triangle: committed inside Proceed (RQ-14)");
+                setHitOf(q.committed, rs, c);  // in place, as h (not copied from it: the same stall)
+                q.committed.frontFace = h.frontFace;
+                commitInPlace(q, COMMITTED_TRIANGLE_HIT, "opaque triangle: committed inside Proceed (RQ-14)");
                 continue;
             }
         } else {
@@ -219,7 +231,6 @@ bool advance(RayQueryState& q) {
                 continue;
             }
         }
-        q.candidate = h;
         q.candidateCommitted = false;
         return true;
     }
@@ -247,7 +258,10 @@ RayQueryState* takeQueryState() {
     tSpareQueryStates.pop_back();
     std::vector<detail::Candidate> candidates = std::move(q->candidates);
     candidates.clear();
-    *q = RayQueryState{};
+    // Made anew where it lies (a fresh state assigned over it was put together on the stack and copied, with wide
+    // loads across its narrow stores: a store-forwarding stall per query).
+    std::destroy_at(q);
+    std::construct_at(q);
     q->candidates = std::move(candidates);
     return q;
 }
@@ -374,7 +388,7 @@ void runTraceRayInlineCalls(std::span<void* const> lanes) {
         }
         RayQueryState& q = *call.query->state_;
         sites[count] = siteOf(*q.inv);
-        rays[count] = GatherRay{&threadOf(q), &q.rs, &sites[count], {}, nullptr};
+        setGatherRay(rays[count], threadOf(q), q.rs, sites[count]);
         outs[count] = &q.candidates;
         of[count++] = &call;
     }
@@ -384,12 +398,6 @@ void runTraceRayInlineCalls(std::span<void* const> lanes) {
 }
 
 }  // namespace detail
-
-namespace {
-constexpr WaveFunction kTraceRayInlineCalls{detail::runTraceRayInlineCalls, kMaxWaveWidth};
-}  // namespace
-
-WaveCall traceRayInlineCall(RayQueryTraceCall& state) { return WaveCall{&kTraceRayInlineCalls, {}, &state}; }
 
 bool RayQueryObject::Proceed() {
     RayQueryState& q = *state_;

@@ -22,6 +22,7 @@
 #include <span>
 
 #include "core/math.h"
+#include "emulator/lane_mask.h"
 #include "emulator/types.h"
 #include "emulator/wave_call.h"
 
@@ -76,12 +77,16 @@ struct RayQueryTraceCall {
     std::exception_ptr failure;
 };
 
-// The wave call of `state` (ShaderContext::callInWave, ShaderWave::CallInWave): the calls of a wave's lanes run
-// together, whatever their queries and acceleration structures.
-WaveCall traceRayInlineCall(RayQueryTraceCall& state);
-
 namespace detail {
 void runTraceRayInlineCalls(std::span<void* const> lanes);
+inline constexpr WaveFunction kTraceRayInlineCalls{runTraceRayInlineCalls, kMaxWaveWidth};
+}
+
+// The wave call of `state` (ShaderContext::callInWave, ShaderWave::CallInWave): the calls of a wave's lanes run
+// together, whatever their queries and acceleration structures. Inline, so that the call is written where it goes
+// (one returned from another file came back through memory and was copied across its narrow stores).
+inline WaveCall traceRayInlineCall(RayQueryTraceCall& state) {
+    return WaveCall{&detail::kTraceRayInlineCalls, {}, &state};
 }
 
 // The object behind RayQuery<...>: a handle. Copies refer to the same state machine (RQ-7), as an HLSL assignment

@@ -30,11 +30,14 @@ struct TypeTag {
     std::string name() const;  // demangled
 };
 
+// T's tag, made once: a reference to it is copied from memory long written (a TypeTag made at each call came back
+// through memory and was read with wider loads than its stores, a store-forwarding stall per call).
 template <class T>
-TypeTag typeTag() {
+const TypeTag& typeTag() {
     static_assert(std::is_trivially_copyable_v<T>, "payloads, attributes and parameters are plain HLSL-like structs");
     static const char anchor = 0;
-    return TypeTag{&anchor, uint32_t(sizeof(T)), typeid(T).name()};
+    static const TypeTag tag{&anchor, uint32_t(sizeof(T)), typeid(T).name()};
+    return tag;
 }
 
 // What the emulator calls: payload/attributes are type-erased pointers whose types

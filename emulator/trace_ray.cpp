@@ -262,7 +262,7 @@ bool prepareClosestHit(ThreadState& ts, RayState& rs, const Site& site, RecordVi
     const GeometryType type = hit.instance->blas->geometries()[hit.geometryIndex].type;
     if (!lookupHitGroupRecord(ts, site, rs, hit, type, record) || !record.entry || !record.entry->closestHit)
         return false;
-    inv = invocation(ts, ShaderStage::ClosestHit, record.entry->closestHit, &record, rs.depth, &rs, &hit);
+    setInvocation(inv, ts, ShaderStage::ClosestHit, record.entry->closestHit, &record, rs.depth, &rs, &hit);
     checkGlobalSignature(ts, siteOf(inv), *record.entry);
     checkPayload(ts, siteOf(inv), *inv.shader, rs.payloadType);
     return true;

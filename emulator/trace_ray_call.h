@@ -22,14 +22,35 @@ struct TraceRayCall {
     TypeTag payloadType;
 };
 
-// The call TraceRay(accelerationStructure, RayFlags, ..., Ray, payload) would make, in HLSL's argument order.
+// `call` made the call TraceRay(accelerationStructure, RayFlags, ..., Ray, payload) would make, in HLSL's argument
+// order, field by field in place: a call returned by value and assigned was copied with wider loads than the stores
+// that built it (a store-forwarding stall per TraceRay).
+template <class Payload>
+void setTraceRayCall(TraceRayCall& call, GpuVirtualAddress accelerationStructure, uint32_t RayFlags,
+                     uint32_t InstanceInclusionMask, uint32_t RayContributionToHitGroupIndex,
+                     uint32_t MultiplierForGeometryContributionToHitGroupIndex, uint32_t MissShaderIndex,
+                     const RayDesc& Ray, Payload& payload) {
+    call.accelerationStructure = accelerationStructure;
+    call.rayFlags = RayFlags;
+    call.instanceInclusionMask = InstanceInclusionMask;
+    call.rayContribution = RayContributionToHitGroupIndex;
+    call.multiplier = MultiplierForGeometryContributionToHitGroupIndex;
+    call.missShaderIndex = MissShaderIndex;
+    call.ray = Ray;
+    call.payload = &payload;
+    call.payloadType = typeTag<Payload>();
+}
+
+// setTraceRayCall's call, by value.
 template <class Payload>
 TraceRayCall traceRayCall(GpuVirtualAddress accelerationStructure, uint32_t RayFlags, uint32_t InstanceInclusionMask,
                           uint32_t RayContributionToHitGroupIndex,
                           uint32_t MultiplierForGeometryContributionToHitGroupIndex, uint32_t MissShaderIndex,
                           const RayDesc& Ray, Payload& payload) {
-    return {accelerationStructure, RayFlags, InstanceInclusionMask, RayContributionToHitGroupIndex,
-            MultiplierForGeometryContributionToHitGroupIndex, MissShaderIndex, Ray, &payload, typeTag<Payload>()};
+    TraceRayCall call;
+    setTraceRayCall(call, accelerationStructure, RayFlags, InstanceInclusionMask, RayContributionToHitGroupIndex,
+                    MultiplierForGeometryContributionToHitGroupIndex, MissShaderIndex, Ray, payload);
+    return call;
 }
 
 }  // namespace refray::dxr

@@ -22,6 +22,15 @@ struct GatherRay {
     std::exception_ptr error;
 };
 
+// `ray` made ready for `rs` (its request is prepared by the gather), field by field in place: a GatherRay put together
+// on the stack and copied was read back with wide loads across its narrow stores (a store-forwarding stall per ray).
+inline void setGatherRay(GatherRay& ray, ThreadState& ts, RayState& rs, const Site& site) {
+    ray.ts = &ts;
+    ray.rs = &rs;
+    ray.site = &site;
+    ray.error = nullptr;
+}
+
 // Gathers the candidates of each of up to kMaxWaveWidth rays rs.ray in rs.tlas (Embree broad phase + exact tests;
 // FLAG-12 skips) into its ts->candidates, in the order TRV-4 meets them (GEN-3). The rays that share a TLAS traverse
 // in Embree packets of up to kMaxGatherPacket, in lane order, and each gets the candidates, order and statistics it

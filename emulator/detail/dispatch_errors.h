@@ -40,6 +40,10 @@ void warn(ThreadState& ts, const Site& site, const Diagnostic& d);
 template <class Make>
 void note(ThreadState& ts, const Site& site, NoteTally& tally, Make make);
 
+// note's repeat: true, and counted, when `tally` already holds the note of this or a smaller launch index. A caller
+// that asks first need not build the site of a note that only counts.
+bool countRepeatedNote(const ThreadState& ts, NoteTally& tally);
+
 // Adds the counts `note` kept back to the thread's log; called once when the dispatch ends.
 void foldNotes(ThreadState& ts);
 
@@ -51,12 +55,15 @@ void foldNotes(ThreadState& ts);
 
 #include "emulator/detail/thread_state.h"
 
+inline bool refray::dxr::detail::countRepeatedNote(const ThreadState& ts, NoteTally& tally) {
+    if (!tally.logged || ts.linearIndex < tally.orderKey) return false;
+    ++tally.more;
+    return true;
+}
+
 template <class Make>
 void refray::dxr::detail::note(ThreadState& ts, const Site& site, NoteTally& tally, Make make) {
-    if (tally.logged && ts.linearIndex >= tally.orderKey) {
-        ++tally.more;
-        return;
-    }
+    if (countRepeatedNote(ts, tally)) return;
     tally.logged = true;
     tally.orderKey = ts.linearIndex;
     tally.first = locate(ts, make(), site);

@@ -11,10 +11,11 @@
 
 namespace refray::dxr::detail {
 
-// An invocation of `shader` for `record` on this thread, at `depth`; `ray` and `hit` for the stages that have them.
-inline Invocation invocation(ThreadState& ts, ShaderStage stage, const ShaderExport* shader, const RecordView* record,
-                             uint32_t depth, RayState* ray = nullptr, HitInfo* hit = nullptr) {
-    Invocation inv;
+// `inv` made an invocation of `shader` for `record` on this thread, at `depth`; `ray` and `hit` for the stages that
+// have them. Field by field in place: an Invocation returned by value and assigned was copied with wide loads across
+// the narrow stores that built it (a store-forwarding stall per invocation).
+inline void setInvocation(Invocation& inv, ThreadState& ts, ShaderStage stage, const ShaderExport* shader,
+                          const RecordView* record, uint32_t depth, RayState* ray = nullptr, HitInfo* hit = nullptr) {
     inv.stage = stage;
     inv.shader = shader;
     inv.record = record;
@@ -23,6 +24,15 @@ inline Invocation invocation(ThreadState& ts, ShaderStage stage, const ShaderExp
     inv.dispatch = ts.dispatch;
     inv.thread = &ts;
     inv.depth = depth;
+    inv.candidateOpaque = true;
+    inv.searchEnded = false;
+}
+
+// setInvocation's invocation, by value (for one constructed where it is declared).
+inline Invocation invocation(ThreadState& ts, ShaderStage stage, const ShaderExport* shader, const RecordView* record,
+                             uint32_t depth, RayState* ray = nullptr, HitInfo* hit = nullptr) {
+    Invocation inv;
+    setInvocation(inv, ts, stage, shader, record, depth, ray, hit);
     return inv;
 }
 

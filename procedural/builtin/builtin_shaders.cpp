@@ -42,8 +42,8 @@ bool radianceCall(ShaderContext& ctx, const RayDesc& ray, uint32_t depth, Radian
                   TraceRayCall& call) {
     if (depth >= kMaxRecursionDepth) return false;
     payload = RadiancePayload{vec4(0.0f), depth + 1};
-    call = traceRayCall(ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_CULL_BACK_FACING_TRIANGLES, 0xFF,
-                        0, kRayTypeCount, 0, ray, payload);
+    setTraceRayCall(call, ctx.globalRootDescriptor(kAccelerationStructure), RAY_FLAG_CULL_BACK_FACING_TRIANGLES, 0xFF,
+                    0, kRayTypeCount, 0, ray, payload);
     return true;
 }
 

@@ -235,16 +235,17 @@ PrimitiveInstancePerFrameBuffer primitiveAttributes(const ShaderContext& ctx) {
 }
 
 template <typename T>
-tvec3<T> HitWorldPosition(const ShaderContext& ctx) {
+[[gnu::always_inline]] inline tvec3<T> HitWorldPosition(const ShaderContext& ctx) {  // inlined: see hlsl::normalize
     return tvec3<T>(ctx.WorldRayOrigin()) + T(ctx.RayTCurrent()) * tvec3<T>(ctx.WorldRayDirection());
 }
 
 // The object ray in the primitive's local space. The direction is not renormalised, so t means the same in world,
 // object and local space (§2.2).
-// PORT: the object-space ray is a parameter, so that a RayQuery's candidate ray goes the same way.
+// PORT: the object-space ray is a parameter, so that a RayQuery's candidate ray goes the same way. Inlined: see
+// hlsl::normalize.
 template <typename T>
-math::Ray<T> GetRayInAABBPrimitiveLocalSpace(vec3 objectRayOrigin, vec3 objectRayDirection,
-                                             const PrimitiveInstancePerFrameBuffer& attr) {
+[[gnu::always_inline]] inline math::Ray<T> GetRayInAABBPrimitiveLocalSpace(vec3 objectRayOrigin, vec3 objectRayDirection,
+                                                                           const PrimitiveInstancePerFrameBuffer& attr) {
     math::Ray<T> ray;
     ray.origin = tvec3<T>(mul(tvec4<T>(tvec3<T>(objectRayOrigin), T(1)), attr.bottomLevelASToLocalSpace));
     ray.direction = mul3x3(tvec3<T>(objectRayDirection), attr.bottomLevelASToLocalSpace);
@@ -259,7 +260,8 @@ math::Ray<T> GetRayInAABBPrimitiveLocalSpace(const ShaderContext& ctx, const Pri
 // matrix, not the inverse transpose (I1).
 // PORT: ObjectToWorld3x4() is a parameter (a RayQuery's candidate matrix, or the intersection shader's).
 template <typename T>
-tvec3<T> NormalToWorld(const Matrix3x4& o2w, const PrimitiveInstancePerFrameBuffer& attr, const tvec3<T>& localNormal) {
+[[gnu::always_inline]] inline tvec3<T> NormalToWorld(const Matrix3x4& o2w, const PrimitiveInstancePerFrameBuffer& attr,
+                                                     const tvec3<T>& localNormal) {  // inlined: see hlsl::normalize
     const tvec3<T> n = mul3x3(localNormal, attr.localSpaceToBottomLevelAS);
     tvec3<T> r;
     for (int i = 0; i < 3; ++i) r[i] = T(o2w.m[i][0]) * n.x + T(o2w.m[i][1]) * n.y + T(o2w.m[i][2]) * n.z;
@@ -429,10 +431,10 @@ bool RadianceRayCall(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, ui
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     rayPayload = RayPayload{vec4(0.0f), currentRayRecursionDepth + 1};
     const TraceRayArguments& radiance = traceRay[RayType::Radiance];
-    call = traceRayCall(ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[RayType::Radiance],
-                        radiance.instanceInclusionMask, /*HitGroup::Offset*/ radiance.rayContribution,
-                        /*HitGroup::GeometryStride*/ radiance.multiplier,
-                        /*MissShader::Offset*/ radiance.missShaderIndex, rayDesc, rayPayload);
+    setTraceRayCall(call, ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[RayType::Radiance],
+                    radiance.instanceInclusionMask, /*HitGroup::Offset*/ radiance.rayContribution,
+                    /*HitGroup::GeometryStride*/ radiance.multiplier,
+                    /*MissShader::Offset*/ radiance.missShaderIndex, rayDesc, rayPayload);
     return true;
 }
 
@@ -451,10 +453,10 @@ bool ShadowRayCall(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint
     // Starts as "hit": closest-hit and any-hit shaders are skipped, only MyMissShader_ShadowRay clears it.
     shadowPayload = ShadowRayPayload{1};
     const TraceRayArguments& shadow = traceRay[RayType::Shadow];
-    call = traceRayCall(ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[RayType::Shadow],
-                        shadow.instanceInclusionMask, /*HitGroup::Offset*/ shadow.rayContribution,
-                        /*HitGroup::GeometryStride*/ shadow.multiplier, /*MissShader::Offset*/ shadow.missShaderIndex,
-                        rayDesc, shadowPayload);
+    setTraceRayCall(call, ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[RayType::Shadow],
+                    shadow.instanceInclusionMask, /*HitGroup::Offset*/ shadow.rayContribution,
+                    /*HitGroup::GeometryStride*/ shadow.multiplier, /*MissShader::Offset*/ shadow.missShaderIndex,
+                    rayDesc, shadowPayload);
     return true;
 }
 
@@ -625,7 +627,16 @@ public:
                     : CurrentExtent<T>(q_.RayTMin(), committedRayT(q_, rayTMax(), variant_), q_.RayFlags());
             objectToWorld_ = q_.CandidateObjectToWorld3x4();
             if constexpr (std::is_same_v<T, float>) {
-                call_ = {shader, primitive.primitiveType, accuracy_, localRay, extent, elapsedTime, primitive.stepScale, {}};
+                // PORT: the pending call's fields set one by one (an aggregate assigned from a temporary was copied
+                // with wider loads than the stores that built it, a store-forwarding stall per candidate).
+                call_.shader = shader;
+                call_.primitiveType = primitive.primitiveType;
+                call_.accuracy = accuracy_;
+                call_.localRay = localRay;
+                call_.extent = extent;
+                call_.elapsedTime = elapsedTime;
+                call_.stepScale = primitive.stepScale;
+                call_.result = {};
                 call = {shader == IntersectionShader::SignedDistancePrimitive ? &kSignedDistanceCalls : &kPrimitiveCalls,
                         {accuracy_, (uint64_t(shader) << 32) | primitive.primitiveType}, &call_};
                 pending_ = true;
@@ -739,7 +750,7 @@ tvec4<T> ReflectedColor(const tvec3<T>& D, const tvec3<T>& normal, const Primiti
 // origin, direction, payload and result, and its reflection ray's.
 template <typename T>
 struct ClosestHitLane {
-    SceneConstantBuffer sceneCB;
+    const SceneConstantBuffer* sceneCB = nullptr;  // PORT: the wave's one copy (WaveShared), not a copy per lane
     PrimitiveConstantBuffer materialCB;
     tvec3<T> normal;
     T checkers = T(1);
@@ -769,11 +780,11 @@ void SampleClosestHit(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay,
     WaveShared<SceneConstantBuffer> scene;  // PORT: g_sceneCB, read once between the lanes
     // Up to the shadow ray: the lane's constants, normal, hit position and the direction to the light.
     const auto openLane = [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l) {
-        l.sceneCB = scene.get(ctx, sceneCB);
+        l.sceneCB = &scene.get(ctx, sceneCB);
         l.materialCB = materialCB(ctx);
         open(ctx, l, wave.attributes<Attributes>(i));
         l.hitPosition = HitWorldPosition<T>(ctx);
-        l.toLight = hlsl::normalize(tvec3<T>(vec3(l.sceneCB.lightPosition)) - l.hitPosition);
+        l.toLight = hlsl::normalize(tvec3<T>(vec3(l.sceneCB->lightPosition)) - l.hitPosition);
     };
     // Shadow component, traced by TraceRay.
     const auto shadowRay = [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall& call) {
@@ -799,7 +810,7 @@ void SampleClosestHit(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay,
             reflectedColor = ReflectedColor(l.D, l.normal, l.materialCB, reflectionColor);
         }
         const tvec4<T> phongColor = CalculatePhongLighting(
-            l.sceneCB, tvec4<T>(l.materialCB.albedo), l.normal, l.shadowRayHit, T(l.materialCB.diffuseCoef),
+            *l.sceneCB, tvec4<T>(l.materialCB.albedo), l.normal, l.shadowRayHit, T(l.materialCB.diffuseCoef),
             T(l.materialCB.specularCoef), T(l.materialCB.specularPower), l.hitPosition,
             tvec3<T>(ctx.WorldRayDirection()));
         const tvec4<T> color = combine(l, phongColor, reflectedColor);
@@ -865,8 +876,8 @@ void MyClosestHitShader_Triangle(ClosestHitWave& wave, const TraceRayArgumentSet
         [](ShaderContext& ctx, ClosestHitLane<T>& l) {
             // Grid lines from the primary camera rays' footprint, even for secondary hits (I7, H4).
             l.checkers = AnalyticalCheckersTexture(
-                HitWorldPosition<T>(ctx), l.normal, tvec3<T>(vec3(l.sceneCB.cameraPosition)),
-                l.sceneCB.projectionToWorld, uvec2(ctx.DispatchRaysIndex()), uvec2(ctx.DispatchRaysDimensions()));
+                HitWorldPosition<T>(ctx), l.normal, tvec3<T>(vec3(l.sceneCB->cameraPosition)),
+                l.sceneCB->projectionToWorld, uvec2(ctx.DispatchRaysIndex()), uvec2(ctx.DispatchRaysDimensions()));
         },
         [](const ClosestHitLane<T>& l, const tvec4<T>& phongColor, const tvec4<T>& reflectedColor) {
             return l.checkers * (phongColor + reflectedColor);

@@ -650,8 +650,11 @@ inline constexpr int N_FRACTAL_ITERATIONS = 4;
 // base corners; ties keep the earlier one) is found and p = Scale*p - v*(Scale - 1); the result
 // is sdPyramid(p, h) * Scale^-n (pow through exp2/log2).
 // h = {sin a, cos a, height}; base half-width a = h.z*h.y/h.x.
+// PORT: the position comes by reference and is copied a component at a time: a vec3 of lanes passed by value was
+// copied with wider loads than the stores that made it (a store-forwarding stall per call).
 template <typename T>
-T sdFractalPyramid(vec3<T> position, const vec3<T>& h, T Scale = T(2), int iterations = N_FRACTAL_ITERATIONS) {
+T sdFractalPyramid(const vec3<T>& at, const vec3<T>& h, T Scale = T(2), int iterations = N_FRACTAL_ITERATIONS) {
+    vec3<T> position(at.x, at.y, at.z);
     const T a = h.z * h.y / h.x;
     const vec3<T> v1(T(0), h.z, T(0));
     const vec3<T> v2(-a, T(0), a);

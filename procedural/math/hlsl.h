@@ -265,9 +265,10 @@ T dot(const vec<N, T, Q>& a, const vec<N, T, Q>& b) { return ScalarOps<T>::dot(a
 // length(v) = sqrt(dot(v, v)).
 template <glm::length_t N, typename T, glm::qualifier Q>
 T length(const vec<N, T, Q>& v) { return hlsl::sqrt(hlsl::dot(v, v)); }
-// normalize(v) = v * rsqrt(dot(v, v)): a zero vector gives NaN components (no guard, H16).
+// normalize(v) = v * rsqrt(dot(v, v)): a zero vector gives NaN components (no guard, H16). Always inlined: a float3
+// returned from a call comes back packed in registers through memory, a store-forwarding stall per call.
 template <glm::length_t N, typename T, glm::qualifier Q>
-vec<N, T, Q> normalize(const vec<N, T, Q>& v) { return v * hlsl::rsqrt(hlsl::dot(v, v)); }
+[[gnu::always_inline]] inline vec<N, T, Q> normalize(const vec<N, T, Q>& v) { return v * hlsl::rsqrt(hlsl::dot(v, v)); }
 // reflect(i, n) = i - 2*dot(n, i)*n.
 template <glm::length_t N, typename T, glm::qualifier Q>
 vec<N, T, Q> reflect(const vec<N, T, Q>& i, const vec<N, T, Q>& n) { return i - T(2) * hlsl::dot(n, i) * n; }

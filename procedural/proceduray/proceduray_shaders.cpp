@@ -289,10 +289,10 @@ bool RadianceRayCall(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, ui
     const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     rayPayload = RayPayload{vec4(0.0f), currentRayRecursionDepth + 1, 0.0f, 0, 0};
     const TraceRayArguments& radiance = traceRay[Radiance];
-    call = traceRayCall(ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[Radiance],
-                        radiance.instanceInclusionMask, /*RayContributionToHitGroupIndex*/ radiance.rayContribution,
-                        /*MultiplierForGeometryContribution*/ radiance.multiplier,
-                        /*MissShaderIndex*/ radiance.missShaderIndex, rayDesc, rayPayload);
+    setTraceRayCall(call, ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[Radiance],
+                    radiance.instanceInclusionMask, /*RayContributionToHitGroupIndex*/ radiance.rayContribution,
+                    /*MultiplierForGeometryContribution*/ radiance.multiplier,
+                    /*MissShaderIndex*/ radiance.missShaderIndex, rayDesc, rayPayload);
     return true;
 }
 
@@ -312,10 +312,10 @@ bool ShadowRayTowardsLightCall(ShaderContext& ctx, const TraceRayArgumentSet& tr
     // Starts as "hit": closest-hit and any-hit shaders are skipped, only Miss_Shadow clears it.
     shadowPayload = ShadowRayPayload{0.0f, 1};
     const TraceRayArguments& shadow = traceRay[Shadow];
-    call = traceRayCall(ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[Shadow],
-                        shadow.instanceInclusionMask, /*RayContributionToHitGroupIndex*/ shadow.rayContribution,
-                        /*MultiplierForGeometryContribution*/ shadow.multiplier,
-                        /*MissShaderIndex*/ shadow.missShaderIndex, rayDesc, shadowPayload);
+    setTraceRayCall(call, ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[Shadow],
+                    shadow.instanceInclusionMask, /*RayContributionToHitGroupIndex*/ shadow.rayContribution,
+                    /*MultiplierForGeometryContribution*/ shadow.multiplier,
+                    /*MissShaderIndex*/ shadow.missShaderIndex, rayDesc, shadowPayload);
     return true;
 }
 
@@ -333,7 +333,7 @@ template <typename T>
 struct ClosestHitLane {
     WaveShared<SceneConstantBuffer>* scene = nullptr;  // g_sceneCB, which the wave's lanes read once between them
     bool returned = false;  // the shader returned early (a debug colour)
-    SceneConstantBuffer sceneCB;
+    const SceneConstantBuffer* sceneCB = nullptr;  // PORT: the wave's one copy in `scene`, not a copy per lane
     PrimitiveConstantBuffer materialCB;
     tvec3<T> normal;
     tvec4<T> albedo;
@@ -356,7 +356,7 @@ struct ClosestHitLane {
     }
     // CalculatePhongLighting with the material's coefficients, at HitWorldPosition() seen along WorldRayDirection().
     tvec4<T> materialPhong(const ShaderContext& ctx) const {
-        return CalculatePhongLighting(sceneCB, albedo, normal, shadowRayHit, T(materialCB.diffuseCoef),
+        return CalculatePhongLighting(*sceneCB, albedo, normal, shadowRayHit, T(materialCB.diffuseCoef),
                                       T(materialCB.specularCoef), T(materialCB.specularPower), HitWorldPosition<T>(ctx),
                                       tvec3<T>(ctx.WorldRayDirection()));
     }
@@ -378,7 +378,7 @@ void LitClosestHit(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay, ui
             l.scene = &scene;
             l.returned = !open(ctx, l, rayPayload, wave.attributes<Attributes>(i));
             if (l.returned || !shadows) return false;
-            return l.shadowTraced = ShadowRayTowardsLightCall<T>(ctx, traceRay, maxDepth, effects, l.sceneCB,
+            return l.shadowTraced = ShadowRayTowardsLightCall<T>(ctx, traceRay, maxDepth, effects, *l.sceneCB,
                                                                  rayPayload.recursionDepth, l.shadowPayload, call);
         },
         [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall& call) {
@@ -456,8 +456,8 @@ void ClosestHit_Triangle(ClosestHitWave& wave, const TraceRayArgumentSet& traceR
     LitClosestHit<T, BuiltInTriangleIntersectionAttributes>(
         wave, traceRay, maxDepth, effects, /*shadows*/ true,
         [](ShaderContext& ctx, ClosestHitLane<T>& l, RayPayload& rayPayload, const BuiltInTriangleIntersectionAttributes&) {
-            l.sceneCB = l.scene->get(ctx, sceneCB);
-            if (l.sceneCB.debugFlag) {
+            l.sceneCB = &l.scene->get(ctx, sceneCB);
+            if (l.sceneCB->debugFlag) {
                 rayPayload.color = vec4(0.0f, 0.0f, 1.0f, 0.0f);
                 return false;
             }
@@ -624,7 +624,7 @@ void ClosestHit_Pacman(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay
                 rayPayload.color = vec4(0.0f, 0.0f, 1.0f, 0.0f);
                 return false;
             }
-            l.sceneCB = l.scene->get(ctx, sceneCB);
+            l.sceneCB = &l.scene->get(ctx, sceneCB);
             l.materialCB = materialCB(ctx);
             l.normal = tvec3<T>(attr.normal);
             l.albedo = tvec4<T>(l.materialCB.albedo);
@@ -758,8 +758,8 @@ void ClosestHit_Julia(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay,
         wave, traceRay, maxDepth, effects, /*shadows*/ false,
         [maxDepth](ShaderContext& ctx, ClosestHitLane<T>& l, RayPayload& rayPayload,
                    const ProceduralPrimitiveAttributes& attr) {
-            l.sceneCB = l.scene->get(ctx, sceneCB);
-            if (l.sceneCB.debugFlag) {
+            l.sceneCB = &l.scene->get(ctx, sceneCB);
+            if (l.sceneCB->debugFlag) {
                 rayPayload.color = vec4(1.0f, 0.0f, 0.0f, 0.0f);
                 return false;
             }
@@ -782,7 +782,7 @@ void ClosestHit_Julia(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay,
             const T specularPower = T(0.2f);
             const bool shadowRayHit = false;
             const tvec4<T> phongColor =
-                CalculatePhongLighting(l.sceneCB, l.albedo, l.normal, shadowRayHit, diffuseCoef, specularCoef,
+                CalculatePhongLighting(*l.sceneCB, l.albedo, l.normal, shadowRayHit, diffuseCoef, specularCoef,
                                        specularPower, HitWorldPosition<T>(ctx), tvec3<T>(ctx.WorldRayDirection()));
             tvec4<T> color = phongColor + reflectedColor;
             color += tvec4<T>(rayPayload.color);
