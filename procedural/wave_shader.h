@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <new>
 #include <optional>
 #include <type_traits>
 
@@ -58,11 +59,16 @@ auto readByTheGroup(dxr::IntersectionWave& wave, Read&& read) {
 // f(lane's ShaderContext) for every active lane of `wave`, in lane order; an inactive lane gets the first active
 // lane's value, so that the math over every lane runs on sane values (a NaN ray would keep a march running). A lane
 // whose `f` throws (an error that stops its launch) leaves the wave (IntersectionWave::forEachLane).
+// Each value is made where it lies (placement new takes f's result without a temporary: one assigned was copied with
+// wider loads than the stores that made it, a store-forwarding stall per lane).
 template <class F>
 auto gatherLanes(dxr::IntersectionWave& wave, F f) {
     using V = decltype(f(wave.lane(0)));
+    static_assert(std::is_trivially_destructible_v<V>);
     std::array<V, dxr::kMaxWaveWidth> values{};
-    wave.forEachLane([&](int i, dxr::ShaderContext& ctx) { values[size_t(i)] = f(ctx); });
+    wave.forEachLane([&](int i, dxr::ShaderContext& ctx) {
+        ::new (static_cast<void*>(&values[size_t(i)])) V(f(ctx));
+    });
     const int first = wave.active().any() ? wave.active().lowest() : 0;
     for (int i = 0; i < dxr::kMaxWaveWidth; ++i)
         if (!wave.isActive(i)) values[size_t(i)] = values[size_t(first)];
@@ -84,10 +90,12 @@ Result toLanes(const std::array<Input, dxr::kMaxWaveWidth>& in, Get get) {
 template <class Result, class Input, class Get, class Queue>
 std::array<Result, dxr::kMaxWaveWidth> throughQueue(dxr::LaneMask lanes, const std::array<Input, dxr::kMaxWaveWidth>& in,
                                                     Get get, Queue&& queue) {
-    std::array<decltype(get(in[0])), dxr::kMaxWaveWidth> items{};
+    using Item = decltype(get(in[0]));
+    static_assert(std::is_trivially_destructible_v<Item>);
+    std::array<Item, dxr::kMaxWaveWidth> items{};
     std::array<Result, dxr::kMaxWaveWidth> results{}, byLane{};
     int count = 0;
-    for (int i : lanes) items[size_t(count++)] = get(in[size_t(i)]);
+    for (int i : lanes) ::new (static_cast<void*>(&items[size_t(count++)])) Item(get(in[size_t(i)]));  // in place
     queue(items.data(), count, results.data());
     count = 0;
     for (int i : lanes) byLane[size_t(i)] = results[size_t(count++)];

@@ -5,7 +5,6 @@
 
 #include <cstring>
 #if defined(__AVX__)
-#include <immintrin.h>
 #endif
 #include <optional>
 #include <span>
@@ -244,15 +243,16 @@ template <typename T>
 // PORT: the object-space ray is a parameter, so that a RayQuery's candidate ray goes the same way. Inlined: see
 // hlsl::normalize.
 template <typename T>
-[[gnu::always_inline]] inline math::Ray<T> GetRayInAABBPrimitiveLocalSpace(vec3 objectRayOrigin, vec3 objectRayDirection,
-                                                                           const PrimitiveInstancePerFrameBuffer& attr) {
+[[gnu::always_inline]] inline math::Ray<T> GetRayInAABBPrimitiveLocalSpace(
+    vec3 objectRayOrigin, vec3 objectRayDirection, const PrimitiveInstancePerFrameBuffer& attr) {
     math::Ray<T> ray;
     ray.origin = tvec3<T>(mul(tvec4<T>(tvec3<T>(objectRayOrigin), T(1)), attr.bottomLevelASToLocalSpace));
     ray.direction = mul3x3(tvec3<T>(objectRayDirection), attr.bottomLevelASToLocalSpace);
     return ray;
 }
 template <typename T>
-math::Ray<T> GetRayInAABBPrimitiveLocalSpace(const ShaderContext& ctx, const PrimitiveInstancePerFrameBuffer& attr) {
+[[gnu::always_inline]] inline math::Ray<T> GetRayInAABBPrimitiveLocalSpace(
+    const ShaderContext& ctx, const PrimitiveInstancePerFrameBuffer& attr) {
     return GetRayInAABBPrimitiveLocalSpace<T>(ctx.ObjectRayOrigin(), ctx.ObjectRayDirection(), attr);
 }
 
@@ -428,13 +428,13 @@ bool RadianceRayCall(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, ui
                      const tvec3<T>& origin, const tvec3<T>& direction, uint32_t currentRayRecursionDepth,
                      RayPayload& rayPayload, TraceRayCall& call) {
     if (currentRayRecursionDepth >= maxDepth) return false;
-    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     rayPayload = RayPayload{vec4(0.0f), currentRayRecursionDepth + 1};
     const TraceRayArguments& radiance = traceRay[RayType::Radiance];
     setTraceRayCall(call, ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[RayType::Radiance],
                     radiance.instanceInclusionMask, /*HitGroup::Offset*/ radiance.rayContribution,
                     /*HitGroup::GeometryStride*/ radiance.multiplier,
-                    /*MissShader::Offset*/ radiance.missShaderIndex, rayDesc, rayPayload);
+                    /*MissShader::Offset*/ radiance.missShaderIndex, /*RayDesc*/ vec3(origin), 0.0f, vec3(direction),
+                    10000.0f, rayPayload);
     return true;
 }
 
@@ -448,15 +448,14 @@ bool ShadowRayCall(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, uint
                    ShadowRayPayload& shadowPayload, TraceRayCall& call) {
     if (currentRayRecursionDepth >= maxDepth) return false;
     if (!kShadowMachinery || !effects.traceShadowRays) return false;  // PORT: shadows switched off (procedural/effects.h)
-    // TMax 10000, not the distance to the light (I2).
-    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     // Starts as "hit": closest-hit and any-hit shaders are skipped, only MyMissShader_ShadowRay clears it.
     shadowPayload = ShadowRayPayload{1};
     const TraceRayArguments& shadow = traceRay[RayType::Shadow];
     setTraceRayCall(call, ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[RayType::Shadow],
                     shadow.instanceInclusionMask, /*HitGroup::Offset*/ shadow.rayContribution,
                     /*HitGroup::GeometryStride*/ shadow.multiplier, /*MissShader::Offset*/ shadow.missShaderIndex,
-                    rayDesc, shadowPayload);
+                    /*RayDesc, TMax 10000, not the distance to the light (I2)*/ vec3(origin), 0.0f,
+                    vec3(direction), 10000.0f, shadowPayload);
     return true;
 }
 
@@ -575,7 +574,7 @@ public:
         pending_ = false;
         tracing_ = true;
         committedNormal_ = tvec3<T>(T(0));
-        storeRay(traceCall_.ray, origin, direction, tMax);
+        storeRayDesc(traceCall_.ray, origin, 0.0f, direction, tMax);  // whole: TraceRayInline reads it at once
     }
     InlineQueryLoop(const InlineQueryLoop&) = delete;
     InlineQueryLoop& operator=(const InlineQueryLoop&) = delete;
@@ -657,19 +656,6 @@ public:
     const tvec3<T>& committedNormal() const { return committedNormal_; }
 
 private:
-    // ray = {origin, 0, direction, tMax}, written whole (one 32-byte store where the CPU has AVX): TraceRayInline reads
-    // it back at once, and a RayDesc pieced together from 4-byte stores cannot be forwarded to its wider reads (the
-    // stall was 1 % of the ambient-occlusion scene's samples).
-    static void storeRay(RayDesc& ray, const vec3& origin, const vec3& direction, float tMax) {
-#if defined(__AVX__)
-        static_assert(sizeof(RayDesc) == 8 * sizeof(float));
-        const __m256 whole = _mm256_setr_ps(origin.x, origin.y, origin.z, 0.0f, direction.x, direction.y,
-                                            direction.z, tMax);
-        std::memcpy(static_cast<void*>(&ray), &whole, sizeof ray);
-#else
-        ray = RayDesc{origin, 0.0f, direction, tMax};
-#endif
-    }
 
     // The candidate's test done: a hit is committed (ACCEPT_FIRST_HIT_AND_END_SEARCH: Proceed then returns FALSE).
     void commitTest(const PrimitiveHit<T>& test) {

@@ -286,13 +286,13 @@ bool RadianceRayCall(ShaderContext& ctx, const TraceRayArgumentSet& traceRay, ui
                      const tvec3<T>& origin, const tvec3<T>& direction, uint32_t currentRayRecursionDepth,
                      RayPayload& rayPayload, TraceRayCall& call) {
     if (currentRayRecursionDepth >= maxDepth) return false;
-    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     rayPayload = RayPayload{vec4(0.0f), currentRayRecursionDepth + 1, 0.0f, 0, 0};
     const TraceRayArguments& radiance = traceRay[Radiance];
     setTraceRayCall(call, ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[Radiance],
                     radiance.instanceInclusionMask, /*RayContributionToHitGroupIndex*/ radiance.rayContribution,
                     /*MultiplierForGeometryContribution*/ radiance.multiplier,
-                    /*MissShaderIndex*/ radiance.missShaderIndex, rayDesc, rayPayload);
+                    /*MissShaderIndex*/ radiance.missShaderIndex, /*RayDesc*/ vec3(origin), 0.0f, vec3(direction),
+                    10000.0f, rayPayload);
     return true;
 }
 
@@ -308,14 +308,14 @@ bool ShadowRayTowardsLightCall(ShaderContext& ctx, const TraceRayArgumentSet& tr
     const tvec3<T> direction = hlsl::normalize(tvec3<T>(g_sceneCB.lightPosition) - origin);
     if (currentRayRecursionDepth >= maxDepth) return false;
     if (!kShadowMachinery || !effects.traceShadowRays) return false;  // PORT: shadows switched off (procedural/effects.h)
-    const RayDesc rayDesc{vec3(origin), 0.0f, vec3(direction), 10000.0f};
     // Starts as "hit": closest-hit and any-hit shaders are skipped, only Miss_Shadow clears it.
     shadowPayload = ShadowRayPayload{0.0f, 1};
     const TraceRayArguments& shadow = traceRay[Shadow];
     setTraceRayCall(call, ctx.globalRootDescriptor(kAccelerationStructure), kTraceRayFlags[Shadow],
                     shadow.instanceInclusionMask, /*RayContributionToHitGroupIndex*/ shadow.rayContribution,
                     /*MultiplierForGeometryContribution*/ shadow.multiplier,
-                    /*MissShaderIndex*/ shadow.missShaderIndex, rayDesc, shadowPayload);
+                    /*MissShaderIndex*/ shadow.missShaderIndex, /*RayDesc*/ vec3(origin), 0.0f, vec3(direction),
+                    10000.0f, shadowPayload);
     return true;
 }
 
