@@ -97,7 +97,7 @@ inline float axis(vec3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
     if (W == 0.0 && !ownsEdge(orientation * (double(Bx) - Ax), orientation * (double(By) - Ay), alternateEdgeRule))
         return false;
 
-    const double Az = double(Sz) * A[kz], Bz = double(Sz) * B[kz], Cz = double(Sz) * C[kz];
+    const double Az = double(Sz) * axis(A, kz), Bz = double(Sz) * axis(B, kz), Cz = double(Sz) * axis(C, kz);
     const double T = U * Az + V * Bz + W * Cz;
     hit.t = float(T / det);
     hit.barycentrics = vec2(float(V / det), float(W / det));
