@@ -2,9 +2,11 @@
 // sample's HLSL matrix type and root-signature layout.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <string>
+#include <type_traits>
 
 #include "core/math.h"
 #include "emulator/ray_generation_wave.h"
@@ -92,16 +94,27 @@ glm::vec<3, T> FresnelReflectanceSchlick(glm::vec<3, T> I, glm::vec<3, T> N, glm
 
 // GenerateCameraRay: pixel centre, y flipped, unprojected with mul(float4(s, 0, 1),
 // projectionToWorld) and divided by w; origin = cameraPosition, direction normalized.
+// GenerateCameraRayFromPixel takes the pixel index and the dimensions in T, converted from their uints (as
+// GenerateCameraRay does), so that the lanes of a wave, each with its own pixel, run it as one.
 template <typename T>
-void GenerateCameraRay(uvec2 index, uvec2 dimensions, glm::vec<3, T> cameraPosition, const Float4x4& projectionToWorld,
-                       glm::vec<3, T>& origin, glm::vec<3, T>& direction) {
-    const glm::vec<2, T> xy = glm::vec<2, T>(index) + T(0.5f);
-    glm::vec<2, T> screenPos = xy / glm::vec<2, T>(dimensions) * T(2) - T(1);
+void GenerateCameraRayFromPixel(glm::vec<2, T> index, glm::vec<2, T> dimensions, glm::vec<3, T> cameraPosition,
+                                const Float4x4& projectionToWorld, glm::vec<3, T>& origin,
+                                glm::vec<3, T>& direction) {
+    const glm::vec<2, T> xy = index + T(0.5f);
+    glm::vec<2, T> screenPos = xy / dimensions * T(2) - T(1);
     screenPos.y = -screenPos.y;
     const glm::vec<4, T> world = mul(glm::vec<4, T>(screenPos, T(0), T(1)), projectionToWorld);
     const glm::vec<3, T> worldXYZ = glm::vec<3, T>(world) / world.w;
     origin = cameraPosition;
     direction = hlsl::normalize(worldXYZ - origin);
+}
+
+// GenerateCameraRay for DispatchRaysIndex().xy and DispatchRaysDimensions().xy as the HLSL passes them.
+template <typename T>
+void GenerateCameraRay(uvec2 index, uvec2 dimensions, glm::vec<3, T> cameraPosition, const Float4x4& projectionToWorld,
+                       glm::vec<3, T>& origin, glm::vec<3, T>& direction) {
+    GenerateCameraRayFromPixel(glm::vec<2, T>(index), glm::vec<2, T>(dimensions), cameraPosition, projectionToWorld,
+                               origin, direction);
 }
 
 // A radiance ray traced alone: `makeCall(payload, call)` builds the TraceRay (false: it makes none, and the result is
@@ -123,12 +136,60 @@ struct CameraSetup {
     Float4x4 projectionToWorld;
 };
 
+// The camera rays of a ray generation wave's lanes: each active lane reads its camera (`camera(ctx)`, once between
+// the lanes through `shared`: a lane whose read fails leaves the wave), and origins[i], directions[i] become lane i's
+// GenerateCameraRay for its DispatchRaysIndex().xy. A float wave computes them in WaveLanes<float>, kWaveLanes lanes
+// at a time (a call of one lane alone in float), each lane bit for bit its one-lane ray (procedural/math/lanes.h).
+template <typename T, class Camera>
+void CameraRays(dxr::RayGenerationWave& wave, WaveShared<CameraSetup<T>>& shared, Camera& camera,
+                std::array<glm::vec<3, T>, dxr::kMaxWaveWidth>& origins,
+                std::array<glm::vec<3, T>, dxr::kMaxWaveWidth>& directions) {
+    std::array<int, dxr::kMaxWaveWidth> order{};
+    std::array<uvec2, dxr::kMaxWaveWidth> pixels{};
+    uvec2 dimensions(0);
+    const CameraSetup<T>* setup = nullptr;
+    int count = 0;
+    wave.forEachLane([&](int i, dxr::ShaderContext& ctx) {
+        setup = &shared.get(ctx, camera);
+        pixels[size_t(i)] = uvec2(ctx.DispatchRaysIndex());
+        dimensions = uvec2(ctx.DispatchRaysDimensions());
+        order[size_t(count++)] = i;
+    });
+    for (int first = 0; first < count; first += kWaveLanes) {
+        const int n = std::min(kWaveLanes, count - first);
+        if (!std::is_same_v<T, float> || n == 1) {
+            for (int k = first; k < first + n; ++k) {
+                const size_t i = size_t(order[size_t(k)]);
+                GenerateCameraRay(pixels[i], dimensions, setup->cameraPosition, setup->projectionToWorld, origins[i],
+                                  directions[i]);
+            }
+            continue;
+        }
+        if constexpr (std::is_same_v<T, float>) {
+            using L = WaveLanes<float>;
+            // The lanes no ray fills hold the group's first pixel, so that their math stays sane.
+            glm::vec<2, L> pixel;
+            for (int j = 0; j < kWaveLanes; ++j)
+                math::setLane(pixel, j, vec2(pixels[size_t(order[size_t(j < n ? first + j : first)])]));
+            const math::LiveLanes live(uint32_t(dxr::LaneMask::first(n).bits()), 0);
+            glm::vec<3, L> origin, direction;
+            GenerateCameraRayFromPixel(pixel, glm::vec<2, L>(vec2(dimensions)), glm::vec<3, L>(setup->cameraPosition),
+                                       setup->projectionToWorld, origin, direction);
+            for (int j = 0; j < n; ++j) {
+                const size_t i = size_t(order[size_t(first + j)]);
+                origins[i] = math::lane(origin, j);
+                directions[i] = math::lane(direction, j);
+            }
+        }
+    }
+}
+
 // The ray generation shader both samples share (D3D12's MyRaygenShader, Proceduray's Raygen), written for waves
 // (emulator/ray_generation_wave.h): each lane reads its camera (`camera(ctx)`: the lane's scene constants), builds its
-// camera ray (GenerateCameraRay) and its radiance TraceRay (`radianceCall(ctx, origin, direction,
-// currentRecursionDepth, payload, call)`: false at MAX_RAY_RECURSION_DEPTH, which leaves the pixel black), the
-// wave's lanes trace together, then each lane writes its colour to the output UAV of descriptor table
-// `outputTable`. Lane by lane it is the HLSL's code.
+// camera ray (GenerateCameraRay, for the wave's lanes together: CameraRays) and its radiance TraceRay
+// (`radianceCall(ctx, origin, direction, currentRecursionDepth, payload, call)`: false at MAX_RAY_RECURSION_DEPTH,
+// which leaves the pixel black), the wave's lanes trace together, then each lane writes its colour to the output UAV
+// of descriptor table `outputTable`. Lane by lane it is the HLSL's code.
 // PORT: the texture stores floats; the R8G8B8A8_UNORM conversion (clamp, round, NaN -> 0) happens when the image is
 // written out (H20).
 // PORT: the camera (the scene's constants) and the output texture are global root arguments, read once between the
@@ -137,22 +198,26 @@ template <typename T, class Payload, class Camera, class RadianceCall>
 void CameraRaygen(dxr::RayGenerationWave& wave, uint32_t outputTable, Camera camera, RadianceCall radianceCall) {
     WaveShared<CameraSetup<T>> shared;
     WaveShared<Image*> output;
-    wave.TraceRayInEachLane<Payload>(
-        [&](dxr::ShaderContext& ctx, Payload& rayPayload, dxr::TraceRayCall& call) {
-            const CameraSetup<T>& setup = shared.get(ctx, camera);
-            glm::vec<3, T> origin, direction;
-            GenerateCameraRay(uvec2(ctx.DispatchRaysIndex()), uvec2(ctx.DispatchRaysDimensions()),
-                              setup.cameraPosition, setup.projectionToWorld, origin, direction);
+    std::array<glm::vec<3, T>, dxr::kMaxWaveWidth> origins, directions;
+    CameraRays(wave, shared, camera, origins, directions);
+    struct Lane {
+        Payload payload;
+        bool traced;
+    };
+    wave.TraceRaysInSteps<Lane>(
+        [&](int i, dxr::ShaderContext& ctx, Lane& l, dxr::TraceRayCall& call) {
             const uint32_t currentRecursionDepth = 0;
-            return radianceCall(ctx, origin, direction, currentRecursionDepth, rayPayload, call);
+            return l.traced = radianceCall(ctx, origins[size_t(i)], directions[size_t(i)], currentRecursionDepth,
+                                           l.payload, call);
         },
-        [&](dxr::ShaderContext& ctx, const Payload& rayPayload, bool traced) {
+        [&](int, dxr::ShaderContext& ctx, Lane& l, dxr::TraceRayCall&) {
             const uvec3 index = ctx.DispatchRaysIndex();
-            const glm::vec<4, T> color = traced ? glm::vec<4, T>(rayPayload.color) : glm::vec<4, T>(T(0));
+            const glm::vec<4, T> color = l.traced ? glm::vec<4, T>(l.payload.color) : glm::vec<4, T>(T(0));
             Image* target = output.get(ctx, [outputTable](const dxr::ShaderContext& lane) {
                 return &lane.rwTexture2D(lane.globalDescriptorTable(outputTable));
             });
             target->at(index.x, index.y) = vec4(color);
+            return false;
         });
 }
 

@@ -110,16 +110,21 @@ T CheckersTextureBoxFilter(tvec2<T> uv, tvec2<T> dpdx, tvec2<T> dpdy, uint32_t r
     return (T(1) - i.x) * (T(1) - i.y);
 }
 
+namespace {
+
+// CalculateRayDifferentials with the neighbouring pixels given in T: ddxPixel = DispatchRaysIndex().xy + uint2(1, 0)
+// and ddyPixel = DispatchRaysIndex().xy + uint2(0, 1), added in uint and converted as GenerateCameraRay converts them.
+// PORT: so that a wave's lanes, each with its own pixel, run it as one (FinalColor).
 template <typename T>
-void CalculateRayDifferentials(tvec2<T>& ddx_uv, tvec2<T>& ddy_uv, tvec2<T> uv, tvec3<T> hitPosition,
-                               tvec3<T> surfaceNormal, tvec3<T> cameraPosition, const Float4x4& projectionToWorld,
-                               uvec2 dispatchRaysIndex, uvec2 dispatchRaysDimensions) {
+void RayDifferentialsThrough(tvec2<T>& ddx_uv, tvec2<T>& ddy_uv, tvec2<T> uv, tvec3<T> hitPosition,
+                             tvec3<T> surfaceNormal, tvec3<T> cameraPosition, const Float4x4& projectionToWorld,
+                             tvec2<T> ddxPixel, tvec2<T> ddyPixel, tvec2<T> dispatchRaysDimensions) {
     // Intersect the neighbouring pixels' primary rays with the tangent plane of the surface.
     tvec3<T> ddxOrigin, ddxDirection, ddyOrigin, ddyDirection;
-    GenerateCameraRay(dispatchRaysIndex + uvec2(1, 0), dispatchRaysDimensions, cameraPosition, projectionToWorld,
-                      ddxOrigin, ddxDirection);
-    GenerateCameraRay(dispatchRaysIndex + uvec2(0, 1), dispatchRaysDimensions, cameraPosition, projectionToWorld,
-                      ddyOrigin, ddyDirection);
+    GenerateCameraRayFromPixel(ddxPixel, dispatchRaysDimensions, cameraPosition, projectionToWorld, ddxOrigin,
+                               ddxDirection);
+    GenerateCameraRayFromPixel(ddyPixel, dispatchRaysDimensions, cameraPosition, projectionToWorld, ddyOrigin,
+                               ddyDirection);
 
     const tvec3<T> ddx_pos = ddxOrigin - ddxDirection * hlsl::dot(ddxOrigin - hitPosition, surfaceNormal) /
                                              hlsl::dot(ddxDirection, surfaceNormal);
@@ -131,22 +136,43 @@ void CalculateRayDifferentials(tvec2<T>& ddx_uv, tvec2<T>& ddy_uv, tvec2<T> uv, 
     ddy_uv = tvec2<T>(ddy_pos.x, ddy_pos.z) - uv;
 }
 
+// AnalyticalCheckersTexture with the neighbouring pixels given in T (RayDifferentialsThrough).
 template <typename T>
-T AnalyticalCheckersTexture(tvec3<T> hitPosition, tvec3<T> surfaceNormal, tvec3<T> cameraPosition,
-                            const Float4x4& projectionToWorld, uvec2 dispatchRaysIndex, uvec2 dispatchRaysDimensions) {
+T CheckersThrough(tvec3<T> hitPosition, tvec3<T> surfaceNormal, tvec3<T> cameraPosition,
+                  const Float4x4& projectionToWorld, tvec2<T> ddxPixel, tvec2<T> ddyPixel,
+                  tvec2<T> dispatchRaysDimensions) {
     tvec2<T> ddx_uv, ddy_uv;
     const tvec2<T> uv(hitPosition.x, hitPosition.z);
-    CalculateRayDifferentials(ddx_uv, ddy_uv, uv, hitPosition, surfaceNormal, cameraPosition, projectionToWorld,
-                              dispatchRaysIndex, dispatchRaysDimensions);
+    RayDifferentialsThrough(ddx_uv, ddy_uv, uv, hitPosition, surfaceNormal, cameraPosition, projectionToWorld, ddxPixel,
+                            ddyPixel, dispatchRaysDimensions);
     return CheckersTextureBoxFilter(uv, ddx_uv, ddy_uv, 50);
 }
 
+}  // namespace
+
 template <typename T>
-tvec4<T> CalculatePhongLighting(const SceneConstantBuffer& sceneCB, tvec4<T> albedo, tvec3<T> normal, bool isInShadow,
-                                T diffuseCoef, T specularCoef, T specularPower, tvec3<T> hitPosition,
-                                tvec3<T> worldRayDirection) {
+void CalculateRayDifferentials(tvec2<T>& ddx_uv, tvec2<T>& ddy_uv, tvec2<T> uv, tvec3<T> hitPosition,
+                               tvec3<T> surfaceNormal, tvec3<T> cameraPosition, const Float4x4& projectionToWorld,
+                               uvec2 dispatchRaysIndex, uvec2 dispatchRaysDimensions) {
+    RayDifferentialsThrough(ddx_uv, ddy_uv, uv, hitPosition, surfaceNormal, cameraPosition, projectionToWorld,
+                            tvec2<T>(dispatchRaysIndex + uvec2(1, 0)), tvec2<T>(dispatchRaysIndex + uvec2(0, 1)),
+                            tvec2<T>(dispatchRaysDimensions));
+}
+
+template <typename T>
+T AnalyticalCheckersTexture(tvec3<T> hitPosition, tvec3<T> surfaceNormal, tvec3<T> cameraPosition,
+                            const Float4x4& projectionToWorld, uvec2 dispatchRaysIndex, uvec2 dispatchRaysDimensions) {
+    return CheckersThrough(hitPosition, surfaceNormal, cameraPosition, projectionToWorld,
+                           tvec2<T>(dispatchRaysIndex + uvec2(1, 0)), tvec2<T>(dispatchRaysIndex + uvec2(0, 1)),
+                           tvec2<T>(dispatchRaysDimensions));
+}
+
+template <typename T>
+tvec4<T> CalculatePhongLighting(const SceneConstantBuffer& sceneCB, tvec4<T> albedo, tvec3<T> normal,
+                                math::LaneMask<T> isInShadow, T diffuseCoef, T specularCoef, T specularPower,
+                                tvec3<T> hitPosition, tvec3<T> worldRayDirection) {
     const tvec3<T> lightPosition = tvec3<T>(vec3(sceneCB.lightPosition));
-    const T shadowFactor = isInShadow ? T(InShadowRadiance) : T(1);
+    const T shadowFactor = math::select(isInShadow, T(InShadowRadiance), T(1));
     const tvec3<T> incidentLightRay = hlsl::normalize(hitPosition - lightPosition);
 
     // Diffuse component.
@@ -155,13 +181,23 @@ tvec4<T> CalculatePhongLighting(const SceneConstantBuffer& sceneCB, tvec4<T> alb
     const tvec4<T> diffuseColor = shadowFactor * diffuseCoef * Kd * lightDiffuseColor * albedo;
 
     // Specular component.
+    // PORT: `if (!isInShadow)`; over lanes, the lanes in shadow keep 0 (and skip its pow).
     tvec4<T> specularColor(T(0));
-    if (!isInShadow) {
+    const auto specular = [&] {
         const tvec4<T> lightSpecularColor(T(1));
         const tvec3<T> reflectedLightRay = hlsl::normalize(hlsl::reflect(incidentLightRay, normal));
         const T Ks = hlsl::pow(hlsl::saturate(hlsl::dot(reflectedLightRay, hlsl::normalize(-worldRayDirection))),
                                specularPower);
-        specularColor = specularCoef * Ks * lightSpecularColor;
+        return specularCoef * Ks * lightSpecularColor;
+    };
+    if constexpr (math::kIsLanes<T>) {
+        const math::LaneMask<T> lit = !isInShadow;
+        if (math::anyLane(lit)) {
+            const math::LiveLanes live(lit);
+            specularColor = math::select(lit, specular(), specularColor);
+        }
+    } else if (!isInShadow) {
+        specularColor = specular();
     }
 
     // Ambient component, with the fake AO that darkens faces turned towards -y.
@@ -183,8 +219,8 @@ tvec4<T> ApplyVisibilityFalloff(tvec4<T> color, T t) {
     template void CalculateRayDifferentials<T>(tvec2<T>&, tvec2<T>&, tvec2<T>, tvec3<T>, tvec3<T>, tvec3<T>,        \
                                                const Float4x4&, uvec2, uvec2);                                      \
     template T AnalyticalCheckersTexture<T>(tvec3<T>, tvec3<T>, tvec3<T>, const Float4x4&, uvec2, uvec2);           \
-    template tvec4<T> CalculatePhongLighting<T>(const SceneConstantBuffer&, tvec4<T>, tvec3<T>, bool, T, T, T,      \
-                                                tvec3<T>, tvec3<T>);                                                \
+    template tvec4<T> CalculatePhongLighting<T>(const SceneConstantBuffer&, tvec4<T>, tvec3<T>, math::LaneMask<T>,  \
+                                                T, T, T, tvec3<T>, tvec3<T>);                                       \
     template tvec4<T> ApplyVisibilityFalloff<T>(tvec4<T>, T);
 REFRAY_INSTANTIATE_HELPERS(float)
 REFRAY_INSTANTIATE_HELPERS(double)
@@ -724,12 +760,55 @@ bool ShadowQueryInline(std::optional<InlineQueryLoop<T>>& loop, ShaderContext& c
 enum class ShadowTracing : uint8_t { TraceRay, Inline };
 
 // reflectanceCoef·(Fresnel, 1)·(reflection ray colour), for the reflection ray along reflect(D, normal) (D: the
-// incoming ray's WorldRayDirection()).
+// incoming ray's WorldRayDirection()); albedo and reflectanceCoef are l_materialCB's.
 template <typename T>
-tvec4<T> ReflectedColor(const tvec3<T>& D, const tvec3<T>& normal, const PrimitiveConstantBuffer& l_materialCB,
+tvec4<T> ReflectedColor(const tvec3<T>& D, const tvec3<T>& normal, const tvec3<T>& albedo, const T& reflectanceCoef,
                         const tvec4<T>& reflectionColor) {
-    const tvec3<T> fresnelR = FresnelReflectanceSchlick(D, normal, tvec3<T>(vec3(l_materialCB.albedo)));
-    return T(l_materialCB.reflectanceCoef) * tvec4<T>(fresnelR, T(1)) * reflectionColor;
+    const tvec3<T> fresnelR = FresnelReflectanceSchlick(D, normal, albedo);
+    return reflectanceCoef * tvec4<T>(fresnelR, T(1)) * reflectionColor;
+}
+
+// What a closest hit's final colour reads once its rays are back, in the math type U: T for one lane, or
+// WaveLanes<float> for up to kWaveLanes lanes of a float wave (one closest hit per lane).
+template <typename U>
+struct FinalColorInput {
+    tvec4<U> albedo;  // l_materialCB's
+    U diffuseCoef, specularCoef, specularPower, reflectanceCoef;
+    math::LaneMask<U> reflects;   // l_materialCB.reflectanceCoef > 0.001 (in float)
+    math::LaneMask<U> reflected;  // RadianceRayCall made the reflection ray (else its colour is black)
+    tvec4<U> reflectionColor;     // the reflection ray's payload colour
+    math::LaneMask<U> inShadow;   // TraceShadowRayAndReportIfHit's result
+    tvec3<U> normal, hitPosition, worldRayDirection;
+    U tCurrent;                   // RayTCurrent()
+    // DispatchRaysIndex().xy + uint2(1, 0), + uint2(0, 1), and DispatchRaysDimensions().xy (the triangle's checkers).
+    tvec2<U> ddxPixel, ddyPixel, dimensions;
+};
+
+// A closest hit's final colour: its reflected component (reflectanceCoef > 0.001), its Phong colour,
+// `combine(in, sceneCB, phongColor, reflectedColor)` and the visibility falloff; lane by lane the HLSL's.
+template <typename U, class Combine>
+tvec4<U> FinalColor(const SceneConstantBuffer& sceneCB, const FinalColorInput<U>& in, Combine& combine) {
+    // PORT: `if (l_materialCB.reflectanceCoef > 0.001)`; over lanes, the lanes without it keep 0.
+    tvec4<U> reflectedColor(U(0));
+    const auto reflected = [&] {
+        // TraceRadianceRay's colour: black where RadianceRayCall made no ray (MAX_RAY_RECURSION_DEPTH).
+        const tvec4<U> reflectionColor = math::select(in.reflected, in.reflectionColor, tvec4<U>(U(0)));
+        return ReflectedColor(in.worldRayDirection, in.normal, tvec3<U>(in.albedo), in.reflectanceCoef,
+                              reflectionColor);
+    };
+    if constexpr (math::kIsLanes<U>) {
+        if (math::anyLane(in.reflects)) {
+            const math::LiveLanes live(in.reflects);
+            reflectedColor = math::select(in.reflects, reflected(), reflectedColor);
+        }
+    } else if (in.reflects) {
+        reflectedColor = reflected();
+    }
+    const tvec4<U> phongColor =
+        CalculatePhongLighting(sceneCB, in.albedo, in.normal, in.inShadow, in.diffuseCoef, in.specularCoef,
+                               in.specularPower, in.hitPosition, in.worldRayDirection);
+    const tvec4<U> color = combine(in, sceneCB, phongColor, reflectedColor);
+    return ApplyVisibilityFalloff(color, in.tCurrent);
 }
 
 // What a closest hit's lane carries from one TraceRay to the next: its constants, its normal, its shadow ray's
@@ -739,27 +818,98 @@ struct ClosestHitLane {
     const SceneConstantBuffer* sceneCB = nullptr;  // PORT: the wave's one copy (WaveShared), not a copy per lane
     PrimitiveConstantBuffer materialCB;
     tvec3<T> normal;
-    T checkers = T(1);
     tvec3<T> hitPosition, toLight;
     ShadowRayPayload shadowPayload;
     bool shadowTraced = false;
     bool shadowRayHit = false;
-    tvec3<T> D;
     RayPayload reflectionPayload;
     bool reflected = false;
 };
 
+// Lane `l`'s FinalColorInput, its rays back.
+template <typename T>
+FinalColorInput<T> finalColorInput(const ClosestHitLane<T>& l, const ShaderContext& ctx) {
+    FinalColorInput<T> in;
+    in.albedo = tvec4<T>(l.materialCB.albedo);
+    in.diffuseCoef = T(l.materialCB.diffuseCoef);
+    in.specularCoef = T(l.materialCB.specularCoef);
+    in.specularPower = T(l.materialCB.specularPower);
+    in.reflectanceCoef = T(l.materialCB.reflectanceCoef);
+    in.reflects = l.materialCB.reflectanceCoef > 0.001f;
+    in.reflected = l.reflected;
+    in.reflectionColor = tvec4<T>(l.reflectionPayload.color);
+    in.inShadow = l.shadowRayHit;
+    in.normal = l.normal;
+    in.hitPosition = l.hitPosition;
+    in.worldRayDirection = tvec3<T>(ctx.WorldRayDirection());
+    in.tCurrent = T(ctx.RayTCurrent());
+    const uvec2 index(ctx.DispatchRaysIndex());
+    in.ddxPixel = tvec2<T>(index + uvec2(1, 0));
+    in.ddyPixel = tvec2<T>(index + uvec2(0, 1));
+    in.dimensions = tvec2<T>(uvec2(ctx.DispatchRaysDimensions()));
+    return in;
+}
+
+// Lane j of `lanes` set to `in` (FinalColorInput over WaveLanes<float>).
+void setLane(FinalColorInput<WaveLanes<float>>& lanes, int j, const FinalColorInput<float>& in) {
+    math::setLane(lanes.albedo, j, in.albedo);
+    math::setLane(lanes.diffuseCoef, j, in.diffuseCoef);
+    math::setLane(lanes.specularCoef, j, in.specularCoef);
+    math::setLane(lanes.specularPower, j, in.specularPower);
+    math::setLane(lanes.reflectanceCoef, j, in.reflectanceCoef);
+    math::setLane(lanes.reflects, j, in.reflects);
+    math::setLane(lanes.reflected, j, in.reflected);
+    math::setLane(lanes.reflectionColor, j, in.reflectionColor);
+    math::setLane(lanes.inShadow, j, in.inShadow);
+    math::setLane(lanes.normal, j, in.normal);
+    math::setLane(lanes.hitPosition, j, in.hitPosition);
+    math::setLane(lanes.worldRayDirection, j, in.worldRayDirection);
+    math::setLane(lanes.tCurrent, j, in.tCurrent);
+    math::setLane(lanes.ddxPixel, j, in.ddxPixel);
+    math::setLane(lanes.ddyPixel, j, in.ddyPixel);
+    math::setLane(lanes.dimensions, j, in.dimensions);
+}
+
+// The final colours of a float wave's lanes `finishing` (their FinalColorInput in `inputs`) into their payloads, in
+// WaveLanes<float>, kWaveLanes lanes at a time (a call of one lane alone in float): each lane's colour is bit for bit
+// what FinalColor<float> gives it alone (procedural/math/lanes.h).
+template <class Combine>
+void FinalColorsInLanes(ClosestHitWave& wave, const SceneConstantBuffer& sceneCB, LaneMask finishing,
+                        const std::array<FinalColorInput<float>, kMaxWaveWidth>& inputs, Combine& combine) {
+    using L = WaveLanes<float>;
+    std::array<int, kMaxWaveWidth> order{};
+    int count = 0;
+    for (int i : finishing) order[size_t(count++)] = i;
+    for (int first = 0; first < count; first += kWaveLanes) {
+        const int n = std::min(kWaveLanes, count - first);
+        if (n == 1) {
+            const int i = order[size_t(first)];
+            wave.payload<RayPayload>(i).color = vec4(FinalColor(sceneCB, inputs[size_t(i)], combine));
+            continue;
+        }
+        [[maybe_unused]] PrecisionScope<L> scope;
+        // The lanes no closest hit fills hold the first one's input, so that their math stays sane.
+        FinalColorInput<L> in;
+        for (int j = 0; j < kWaveLanes; ++j) setLane(in, j, inputs[size_t(order[size_t(j < n ? first + j : first)])]);
+        const math::LiveLanes live(uint32_t(LaneMask::first(n).bits()), 0);
+        const tvec4<L> color = FinalColor(sceneCB, in, combine);
+        for (int j = 0; j < n; ++j) wave.payload<RayPayload>(order[size_t(first + j)]).color = math::lane(color, j);
+    }
+}
+
 // The code both closest hits share, over the lanes of a wave (emulator/closest_hit_wave.h), lane by lane the HLSL's:
 // `open(ctx, lane, attr)` reads a lane's normal; its shadow ray from HitWorldPosition() towards the light
-// (TraceShadowRayAndReportIfHit, or traced inline); `beforeReflection(ctx, lane)` (the triangle's checkers); its
-// reflected component, reflectanceCoef > 0.001 (ReflectedColor: a reflection ray); its Phong colour, `combine(lane,
-// phongColor, reflectedColor)`, and the visibility falloff. The lanes' shadow rays go out together (TraceRay), or
-// their inline queries' loops run together (ShaderWave::CallsInLoop); then their reflection rays
-// (TracingWave::TraceRaysInSteps).
-template <typename T, class Attributes, class Open, class BeforeReflection, class Combine>
+// (TraceShadowRayAndReportIfHit, or traced inline); its reflected component, reflectanceCoef > 0.001 (ReflectedColor:
+// a reflection ray); then FinalColor, with `combine(in, sceneCB, phongColor, reflectedColor)` (the triangle's
+// checkers). The lanes' shadow rays go out together (TraceRay), or their inline queries' loops run together
+// (ShaderWave::CallsInLoop); then their reflection rays (TracingWave::TraceRaysInSteps); then, in float, their final
+// colours in lanes (FinalColorsInLanes).
+// PORT: the checkers, which the HLSL computes before the reflection ray, come with the final colour: they read
+// nothing the ray changes.
+template <typename T, class Attributes, class Open, class Combine>
 void SampleClosestHit(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay, const Accuracy& accuracy,
                       const Effects& effects, ShadowTracing tracing, InlineVariant variant, Open open,
-                      BeforeReflection beforeReflection, Combine combine) {
+                      Combine combine) {
     [[maybe_unused]] PrecisionScope<T> scope;
     const uint32_t maxDepth = maxRayRecursionDepth(accuracy);
     std::array<ClosestHitLane<T>, kMaxWaveWidth> lanes;
@@ -781,30 +931,31 @@ void SampleClosestHit(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay,
     // Reflected component: the ray of ReflectedColor, when reflectanceCoef > 0.001.
     const auto reflectionRay = [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall& call) {
         if (l.shadowTraced) l.shadowRayHit = l.shadowPayload.hit != 0;  // TraceShadowRayAndReportIfHit's result
-        beforeReflection(ctx, l);
         if (!(l.materialCB.reflectanceCoef > 0.001f)) return false;
-        l.D = tvec3<T>(ctx.WorldRayDirection());
-        return l.reflected = RadianceRayCall(ctx, traceRay, maxDepth, l.hitPosition, hlsl::reflect(l.D, l.normal),
+        const tvec3<T> D(ctx.WorldRayDirection());
+        return l.reflected = RadianceRayCall(ctx, traceRay, maxDepth, l.hitPosition, hlsl::reflect(D, l.normal),
                                              wave.payload<RayPayload>(i).recursionDepth, l.reflectionPayload, call);
     };
-    // Final colour, then the visibility falloff.
+    // Final colour, then the visibility falloff: in float, each lane's input kept for FinalColorsInLanes.
+    std::array<FinalColorInput<T>, kMaxWaveWidth> finalInputs;
+    LaneMask finishing;
     const auto finalColor = [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall&) {
-        tvec4<T> reflectedColor(T(0));
-        if (l.materialCB.reflectanceCoef > 0.001f) {
-            // TraceRadianceRay's colour: black where RadianceRayCall made no ray (MAX_RAY_RECURSION_DEPTH).
-            const tvec4<T> reflectionColor = l.reflected ? tvec4<T>(l.reflectionPayload.color) : tvec4<T>(T(0));
-            reflectedColor = ReflectedColor(l.D, l.normal, l.materialCB, reflectionColor);
+        if constexpr (std::is_same_v<T, float>) {
+            finalInputs[size_t(i)] = finalColorInput(l, ctx);
+            finishing.set(i);
+        } else {
+            wave.payload<RayPayload>(i).color = vec4(FinalColor(*l.sceneCB, finalColorInput(l, ctx), combine));
         }
-        const tvec4<T> phongColor = CalculatePhongLighting(
-            *l.sceneCB, tvec4<T>(l.materialCB.albedo), l.normal, l.shadowRayHit, T(l.materialCB.diffuseCoef),
-            T(l.materialCB.specularCoef), T(l.materialCB.specularPower), l.hitPosition,
-            tvec3<T>(ctx.WorldRayDirection()));
-        const tvec4<T> color = combine(l, phongColor, reflectedColor);
-        wave.payload<RayPayload>(i).color = vec4(ApplyVisibilityFalloff(color, T(ctx.RayTCurrent())));
         return false;
+    };
+    const auto finalColorsInLanes = [&] {
+        if constexpr (std::is_same_v<T, float>)
+            if (finishing.any())
+                FinalColorsInLanes(wave, *lanes[size_t(finishing.lowest())].sceneCB, finishing, finalInputs, combine);
     };
     if (tracing == ShadowTracing::TraceRay) {
         wave.TraceRaysInSteps(std::span<ClosestHitLane<T>>(lanes), shadowRay, reflectionRay, finalColor);
+        finalColorsInLanes();
         return;
     }
     // Shadow component, traced inline: the lanes' queries' loops together.
@@ -825,6 +976,7 @@ void SampleClosestHit(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay,
         if (querying.test(i)) l.shadowRayHit = AnyHitQueryResult(*shadowQueries[size_t(i)]);
     });
     wave.TraceRaysInSteps(std::span<ClosestHitLane<T>>(lanes), reflectionRay, finalColor);
+    finalColorsInLanes();
 }
 
 // ---- Entry points ----------------------------------------------------------------------------------
@@ -859,14 +1011,12 @@ void MyClosestHitShader_Triangle(ClosestHitWave& wave, const TraceRayArgumentSet
             // The normal of the triangle's first vertex, untransformed.
             l.normal = tvec3<T>(FirstVertexNormal(ctx, kVertexBuffers));
         },
-        [](ShaderContext& ctx, ClosestHitLane<T>& l) {
+        []<typename U>(const FinalColorInput<U>& in, const SceneConstantBuffer& sceneCB, const tvec4<U>& phongColor,
+                       const tvec4<U>& reflectedColor) {
             // Grid lines from the primary camera rays' footprint, even for secondary hits (I7, H4).
-            l.checkers = AnalyticalCheckersTexture(
-                HitWorldPosition<T>(ctx), l.normal, tvec3<T>(vec3(l.sceneCB->cameraPosition)),
-                l.sceneCB->projectionToWorld, uvec2(ctx.DispatchRaysIndex()), uvec2(ctx.DispatchRaysDimensions()));
-        },
-        [](const ClosestHitLane<T>& l, const tvec4<T>& phongColor, const tvec4<T>& reflectedColor) {
-            return l.checkers * (phongColor + reflectedColor);
+            const U checkers = CheckersThrough(in.hitPosition, in.normal, tvec3<U>(vec3(sceneCB.cameraPosition)),
+                                               sceneCB.projectionToWorld, in.ddxPixel, in.ddyPixel, in.dimensions);
+            return checkers * (phongColor + reflectedColor);
         });
 }
 
@@ -879,10 +1029,8 @@ void MyClosestHitShader_AABB(ClosestHitWave& wave, const TraceRayArgumentSet& tr
         [](ShaderContext&, ClosestHitLane<T>& l, const ProceduralPrimitiveAttributes& attr) {
             l.normal = tvec3<T>(attr.normal);
         },
-        [](ShaderContext&, ClosestHitLane<T>&) {},
-        [](const ClosestHitLane<T>&, const tvec4<T>& phongColor, const tvec4<T>& reflectedColor) {
-            return phongColor + reflectedColor;
-        });
+        []<typename U>(const FinalColorInput<U>&, const SceneConstantBuffer&, const tvec4<U>& phongColor,
+                       const tvec4<U>& reflectedColor) { return phongColor + reflectedColor; });
 }
 
 void MyMissShader(ShaderContext&, RayPayload& rayPayload) { rayPayload.color = BackgroundColor; }

@@ -231,10 +231,11 @@ T AnalyticalCheckersTexture(glm::vec<3, T> hitPosition, glm::vec<3, T> surfaceNo
                             const Float4x4& projectionToWorld, uvec2 dispatchRaysIndex, uvec2 dispatchRaysDimensions);
 
 // CalculatePhongLighting: ambient (darkened towards -y) + diffuse (scaled by InShadowRadiance in shadow) + white
-// specular (only when not in shadow, not gated by N·L: I8) for the point light of g_sceneCB (§2.11).
+// specular (only when not in shadow, not gated by N·L: I8) for the point light of g_sceneCB (§2.11). isInShadow is
+// a bool for a scalar T, a lane mask for lanes (one closest hit per lane: procedural/math/lanes.h).
 template <typename T>
 glm::vec<4, T> CalculatePhongLighting(const SceneConstantBuffer& sceneCB, glm::vec<4, T> albedo, glm::vec<3, T> normal,
-                                      bool isInShadow, T diffuseCoef, T specularCoef, T specularPower,
+                                      math::LaneMask<T> isInShadow, T diffuseCoef, T specularCoef, T specularPower,
                                       glm::vec<3, T> hitPosition, glm::vec<3, T> worldRayDirection);
 
 // The "visibility falloff" of both closest hits: lerp(color, BackgroundColor, 1 - exp(-0.000002·t³)).
