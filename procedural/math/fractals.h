@@ -664,6 +664,24 @@ T sdFractalPyramid(const vec3<T>& at, const vec3<T>& h, T Scale = T(2), int iter
 
     int n = 0;
     for (n = 0; n < iterations; n++) {
+        if constexpr (kIsLanes<T>) {
+            // PORT: over lanes, the four `if (d < dist) { v = vk; dist = d; }` pick the same vertex another way: the
+            // first one at the least distance. The least distance comes from a tree of minimums (lesserOf), and
+            // each lane takes the first vertex whose distance equals it; where a lane's distances are NaN (a NaN
+            // position reaches all five) none equals it and the lane keeps v1, as the ifs do. Bit for bit the ifs'
+            // choice (tests/procedural/lanes_*_test.cpp), in a chain of dependent instructions half as long: these
+            // iterations are latency-bound.
+            const T d1 = length_toPow2(position - v1), d2 = length_toPow2(position - v2);
+            const T d3 = length_toPow2(position - v3), d4 = length_toPow2(position - v4);
+            const T d5 = length_toPow2(position - v5);
+            const T least = lesserOf(lesserOf(lesserOf(d1, d2), lesserOf(d3, d4)), d5);
+            const vec3<T> v =
+                select(d1 == least, v1,
+                       select(d2 == least, v2,
+                              select(d3 == least, v3, select(d4 == least, v4, select(d5 == least, v5, v1)))));
+            position = Scale * position - v * (Scale - T(1));
+            continue;
+        }
         T dist;
         T d;
         vec3<T> v;

@@ -273,6 +273,19 @@ template <int N>
                                                   const LaneBools<N>& b) {
     return (m & a) | (!m & b);
 }
+// b < a ? b : a, lane by lane: the lesser of the two, and a where they are equal or either is NaN. For float lanes
+// it is one minimum instruction (x86's minps computes exactly this), where select(b < a, b, a) is a compare and a
+// blend that depends on it.
+template <class S, int N>
+[[gnu::always_inline]] inline Lanes<S, N> lesserOf(const Lanes<S, N>& a, const Lanes<S, N>& b) {
+    Lanes<S, N> r;
+    if constexpr (Lanes<S, N>::kVector) {
+        r.v = b.v < a.v ? b.v : a.v;
+    } else {
+        for (int i = 0; i < N; ++i) r.v[i] = b.v[i] < a.v[i] ? b.v[i] : a.v[i];
+    }
+    return r;
+}
 // Vectors of lanes (GLM's vec<K, Lanes>), component by component.
 template <glm::length_t K, class S, int N, glm::qualifier Q>
 [[gnu::always_inline]] inline glm::vec<K, Lanes<S, N>, Q> select(const LaneBools<N>& m,

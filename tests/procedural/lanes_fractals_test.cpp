@@ -508,6 +508,35 @@ TEST(LanesFractals, FractalPyramidAndSignedDistanceSwitchMatchScalarPerLane) {
     }
 }
 
+// The lanes pick the pyramid's nearest vertex by a tree of minimums, the scalar code by four ifs in order: the same
+// vertex where distances tie (at (0, 0.5, 0) the apex ties with the four base vertices; on the axis and the base's
+// diagonals base vertices tie), where a position is NaN, infinite or huge, and with denormal distances (flushed, as
+// the float ports run). Each lane's distance is bit for bit its scalar result.
+TEST(LanesFractals, FractalPyramidPicksTheIfsVertexOnTiesNaNAndInfinity) {
+    hlsl::ScopedFlushDenormals ftz;
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    const float tiny = std::numeric_limits<float>::denorm_min();
+    const std::vector<glm::vec3> points = {
+        {0, 0, 0},           {0, 1, 0},       {0, -3, 0},          {0.5f, 0, 0.5f},   {-0.5f, 0, 0.5f},
+        {0.5f, 0, -0.5f},    {0, 0.2f, 0.7f}, {0.7f, 0.2f, 0},     {nan, 0, 0},       {0, nan, 1},
+        {inf, 0, 0},         {-inf, inf, 0},  {3e19f, 0, 3e19f},   {0, 3e19f, 0},     {tiny, 0, tiny},
+        {-tiny, tiny, tiny}, {1e-20f, 0, 0},  {0, 0, -1e-20f},     {0.25f, 0.5f, 0},  {0, 0.5f, 0.25f},
+        {0, 0.5f, 0},
+    };
+    const vec3<float> h(0.894f, 0.447f, 2.0f);
+    for (size_t first = 0; first < points.size(); ++first) {
+        vec3<L> p;
+        for (int i = 0; i < kTestLanes; ++i) setLane(p, i, points[(first + size_t(i)) % points.size()]);
+        const L lanes = d3d12::sdFractalPyramid(p, vec3<L>(h), L(2), 4);
+        for (int i = 0; i < kTestLanes; ++i) {
+            const glm::vec3 q = points[(first + size_t(i)) % points.size()];
+            const float scalar = d3d12::sdFractalPyramid(vec3<float>(q), h, 2.0f, 4);
+            EXPECT_EQ(std::bit_cast<std::uint32_t>(lane(lanes, i)), std::bit_cast<std::uint32_t>(scalar))
+                << "position (" << q.x << ", " << q.y << ", " << q.z << ")";
+        }
+    }
+}
+
 // ---- PerturbedFloat: every converted function still instantiates (masks are bool), and without a perturbed::Scope
 // it computes exactly what float does.
 TEST(LanesFractals, PerturbedFloatStillInstantiatesAndEqualsFloatWithoutScope) {
