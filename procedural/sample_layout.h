@@ -144,43 +144,36 @@ template <typename T, class Camera>
 void CameraRays(dxr::RayGenerationWave& wave, WaveShared<CameraSetup<T>>& shared, Camera& camera,
                 std::array<glm::vec<3, T>, dxr::kMaxWaveWidth>& origins,
                 std::array<glm::vec<3, T>, dxr::kMaxWaveWidth>& directions) {
-    std::array<int, dxr::kMaxWaveWidth> order{};
     std::array<uvec2, dxr::kMaxWaveWidth> pixels{};
     uvec2 dimensions(0);
     const CameraSetup<T>* setup = nullptr;
-    int count = 0;
+    dxr::LaneMask lanes;
     wave.forEachLane([&](int i, dxr::ShaderContext& ctx) {
         setup = &shared.get(ctx, camera);
         pixels[size_t(i)] = uvec2(ctx.DispatchRaysIndex());
         dimensions = uvec2(ctx.DispatchRaysDimensions());
-        order[size_t(count++)] = i;
+        lanes.set(i);
     });
-    for (int first = 0; first < count; first += kWaveLanes) {
-        const int n = std::min(kWaveLanes, count - first);
-        if (!std::is_same_v<T, float> || n == 1) {
-            for (int k = first; k < first + n; ++k) {
-                const size_t i = size_t(order[size_t(k)]);
-                GenerateCameraRay(pixels[i], dimensions, setup->cameraPosition, setup->projectionToWorld, origins[i],
-                                  directions[i]);
-            }
-            continue;
-        }
-        if constexpr (std::is_same_v<T, float>) {
-            using L = WaveLanes<float>;
-            // The lanes no ray fills hold the group's first pixel, so that their math stays sane.
+    const auto alone = [&](int i) {
+        GenerateCameraRay(pixels[size_t(i)], dimensions, setup->cameraPosition, setup->projectionToWorld,
+                          origins[size_t(i)], directions[size_t(i)]);
+    };
+    if constexpr (!std::is_same_v<T, float>) {
+        for (int i : lanes) alone(i);
+    } else {
+        using L = WaveLanes<float>;
+        const auto group = [&](const std::array<int, kWaveLanes>& lane, int n) {
             glm::vec<2, L> pixel;
-            for (int j = 0; j < kWaveLanes; ++j)
-                math::setLane(pixel, j, vec2(pixels[size_t(order[size_t(j < n ? first + j : first)])]));
-            const math::LiveLanes live(uint32_t(dxr::LaneMask::first(n).bits()), 0);
+            for (int j = 0; j < kWaveLanes; ++j) math::setLane(pixel, j, vec2(pixels[size_t(lane[size_t(j)])]));
             glm::vec<3, L> origin, direction;
             GenerateCameraRayFromPixel(pixel, glm::vec<2, L>(vec2(dimensions)), glm::vec<3, L>(setup->cameraPosition),
                                        setup->projectionToWorld, origin, direction);
             for (int j = 0; j < n; ++j) {
-                const size_t i = size_t(order[size_t(first + j)]);
-                origins[i] = math::lane(origin, j);
-                directions[i] = math::lane(direction, j);
+                origins[size_t(lane[size_t(j)])] = math::lane(origin, j);
+                directions[size_t(lane[size_t(j)])] = math::lane(direction, j);
             }
-        }
+        };
+        inGroupsOfLanes(lanes, group, alone);
     }
 }
 

@@ -5,6 +5,7 @@
 // (procedural/math/lanes.h), so each lane's result is bit for bit the one-ray result.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <new>
 #include <optional>
@@ -100,6 +101,29 @@ std::array<Result, dxr::kMaxWaveWidth> throughQueue(dxr::LaneMask lanes, const s
     count = 0;
     for (int i : lanes) byLane[size_t(i)] = results[size_t(count++)];
     return byLane;
+}
+
+// The lanes `lanes` of a wave in lane order, kWaveLanes at a time, for math that runs in WaveLanes: `group(lane, n)`
+// for a group of n > 1 lanes, where lane[j] is the group's j-th wave lane for j < n and its first one beyond (the
+// padding holds a filled lane's values, so that its math stays sane; only the first n lanes are live, LiveLanes), and
+// `alone(i)` for a group of one lane, which runs in the scalar type (no lanes to pay for). The last group holds the
+// remainder.
+template <class Group, class Alone>
+void inGroupsOfLanes(dxr::LaneMask lanes, Group&& group, Alone&& alone) {
+    std::array<int, dxr::kMaxWaveWidth> order{};
+    int count = 0;
+    for (int i : lanes) order[size_t(count++)] = i;
+    for (int first = 0; first < count; first += kWaveLanes) {
+        const int n = std::min(kWaveLanes, count - first);
+        if (n == 1) {
+            alone(order[size_t(first)]);
+            continue;
+        }
+        std::array<int, kWaveLanes> lane{};
+        for (int j = 0; j < kWaveLanes; ++j) lane[size_t(j)] = order[size_t(j < n ? first + j : first)];
+        const math::LiveLanes live(uint32_t(dxr::LaneMask::first(n).bits()), 0);
+        group(lane, n);
+    }
 }
 
 // Calls f.template operator()<L>() with the lane type a record group's math runs in: T itself for a group of one lane

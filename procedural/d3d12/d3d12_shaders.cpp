@@ -877,24 +877,16 @@ template <class Combine>
 void FinalColorsInLanes(ClosestHitWave& wave, const SceneConstantBuffer& sceneCB, LaneMask finishing,
                         const std::array<FinalColorInput<float>, kMaxWaveWidth>& inputs, Combine& combine) {
     using L = WaveLanes<float>;
-    std::array<int, kMaxWaveWidth> order{};
-    int count = 0;
-    for (int i : finishing) order[size_t(count++)] = i;
-    for (int first = 0; first < count; first += kWaveLanes) {
-        const int n = std::min(kWaveLanes, count - first);
-        if (n == 1) {
-            const int i = order[size_t(first)];
-            wave.payload<RayPayload>(i).color = vec4(FinalColor(sceneCB, inputs[size_t(i)], combine));
-            continue;
-        }
-        [[maybe_unused]] PrecisionScope<L> scope;
-        // The lanes no closest hit fills hold the first one's input, so that their math stays sane.
+    const auto group = [&](const std::array<int, kWaveLanes>& lane, int n) {
         FinalColorInput<L> in;
-        for (int j = 0; j < kWaveLanes; ++j) setLane(in, j, inputs[size_t(order[size_t(j < n ? first + j : first)])]);
-        const math::LiveLanes live(uint32_t(LaneMask::first(n).bits()), 0);
+        for (int j = 0; j < kWaveLanes; ++j) setLane(in, j, inputs[size_t(lane[size_t(j)])]);
         const tvec4<L> color = FinalColor(sceneCB, in, combine);
-        for (int j = 0; j < n; ++j) wave.payload<RayPayload>(order[size_t(first + j)]).color = math::lane(color, j);
-    }
+        for (int j = 0; j < n; ++j) wave.payload<RayPayload>(lane[size_t(j)]).color = math::lane(color, j);
+    };
+    const auto alone = [&](int i) {
+        wave.payload<RayPayload>(i).color = vec4(FinalColor(sceneCB, inputs[size_t(i)], combine));
+    };
+    inGroupsOfLanes(finishing, group, alone);
 }
 
 // The code both closest hits share, over the lanes of a wave (emulator/closest_hit_wave.h), lane by lane the HLSL's:
@@ -936,8 +928,11 @@ void SampleClosestHit(ClosestHitWave& wave, const TraceRayArgumentSet& traceRay,
         return l.reflected = RadianceRayCall(ctx, traceRay, maxDepth, l.hitPosition, hlsl::reflect(D, l.normal),
                                              wave.payload<RayPayload>(i).recursionDepth, l.reflectionPayload, call);
     };
-    // Final colour, then the visibility falloff: in float, each lane's input kept for FinalColorsInLanes.
-    std::array<FinalColorInput<T>, kMaxWaveWidth> finalInputs;
+    // Final colour, then the visibility falloff: in float, each lane's input kept for FinalColorsInLanes (the other
+    // types shade each lane at once and keep none).
+    struct NoInputs {};
+    std::conditional_t<std::is_same_v<T, float>, std::array<FinalColorInput<float>, kMaxWaveWidth>, NoInputs>
+        finalInputs;
     LaneMask finishing;
     const auto finalColor = [&](int i, ShaderContext& ctx, ClosestHitLane<T>& l, TraceRayCall&) {
         if constexpr (std::is_same_v<T, float>) {
