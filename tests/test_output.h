@@ -8,9 +8,10 @@
 
 namespace refray::testing {
 
-// REFRAY_TEST_OUTPUT_DIR/group/Suite.Test, created. ctest runs every test in a process of its own, several at a
-// time, so files that more than one test writes under one name must live apart: one test rewriting a file while
-// another reads it lets the reader see it empty or half written.
+// REFRAY_TEST_OUTPUT_DIR/group/Suite.Test, created. ctest runs several processes at a time (a suite each, or a test
+// each for the lavapipe and discrimination binaries; tests/CMakeLists.txt), so files that more than one test writes
+// under one name must live apart: one test rewriting a file while another reads it lets the reader see it empty or
+// half written.
 inline std::filesystem::path testOutputDirectory(const std::string& group) {
     const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
     std::filesystem::path directory = std::filesystem::path(REFRAY_TEST_OUTPUT_DIR) / group;
