@@ -4,12 +4,26 @@
 // pass. A failure still exits 1.
 #include <gtest/gtest.h>
 
+#include <string_view>
+
+namespace {
+// GoogleTest's own help flags: a run that only prints the help runs no test and is not a skip.
+bool asksForHelp(int argc, char** argv) {
+    for (int i = 1; i < argc; ++i) {
+        const std::string_view arg = argv[i];
+        if (arg == "--help" || arg == "-h" || arg == "-?" || arg == "/?" || arg == "--gtest_help") return true;
+    }
+    return false;
+}
+}  // namespace
+
 int main(int argc, char** argv) {
+    const bool help = asksForHelp(argc, argv);
     ::testing::InitGoogleTest(&argc, argv);
     const int result = RUN_ALL_TESTS();
     const ::testing::UnitTest& unit = *::testing::UnitTest::GetInstance();
     if (result == 0 && unit.successful_test_count() == 0 && unit.failed_test_count() == 0 &&
-        !::testing::GTEST_FLAG(list_tests))
+        !::testing::GTEST_FLAG(list_tests) && !help)
         return 77;
     return result;
 }
