@@ -41,7 +41,7 @@ bundle="$root/.gpu-bundle"
 if [ "$do_build" = 1 ]; then
   export CMAKE_CXX_COMPILER_LAUNCHER=${CMAKE_CXX_COMPILER_LAUNCHER:-ccache} CMAKE_C_COMPILER_LAUNCHER=${CMAKE_C_COMPILER_LAUNCHER:-ccache}
   # For another machine's CPU: not -march=native (REFRAY_NATIVE_ARCH), in a build directory of its own.
-  (cd "$root" && cmake --preset release -B "$build_dir" -DREFRAY_VULKAN=ON -DREFRAY_NATIVE_ARCH=OFF >/dev/null &&
+  (cd "$root" && cmake --preset release -B "$build_dir" -DREFRAY_VULKAN=ON -DREFRAY_NATIVE_ARCH=OFF -DREFRAY_PGO=OFF >/dev/null &&
      cmake --build "$build_dir" -j2 --target refray refray_spirv)
 fi
 binary="$build_dir/tools/refray"

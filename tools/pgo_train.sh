@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# The release build's profile (cmake/RefrayProfileGuided.cmake, docs/performance.md "Profile-guided and link-time
+# optimisation"): builds the instrumented `pgo-train` preset's refray, renders the training set with it, and writes
+# the profile to build/pgo-profile: GCC's counters and profile.stamp, their hash, which the release build reads (a
+# new stamp makes it configure again and recompile). The training set: every golden setting of
+# tests/golden/goldens.json at 320x180, a double and a perturbed render (the envelope goldens' precisions) and the
+# path tracer's two scenes, small, on one thread (the counters, and so the profile and the compiled objects that
+# ccache keeps, are then the same on every run). About a minute on 2 cores once built.
+# It renders again only when the instrumented refray is newer than the stamp, or with --force.
+#   bash tools/pgo_train.sh [--force]
+# Exit status: 0 (a profile is there), 1 (a build or a training render failed: the message says which), 2 (usage).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+force=0
+case "${1:-}" in
+  "") ;;
+  --force) force=1 ;;
+  -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
+  *) echo "pgo_train: unknown argument '$1' (--force)" >&2; exit 2 ;;
+esac
+profile=build/pgo-profile
+stamp=$profile/profile.stamp
+binary=build/pgo-train/tools/refray
+
+if [ ! -f build/pgo-train/build.ninja ]; then
+  echo "pgo_train: configuring build/pgo-train (the instrumented build)" >&2
+  cmake --preset pgo-train >&2
+fi
+echo "pgo_train: building the instrumented refray" >&2
+cmake --build --preset pgo-train -j "$(nproc)" >&2
+if [ "$force" = 0 ] && [ -f "$stamp" ] && [ "$stamp" -nt "$binary" ]; then
+  echo "pgo_train: the profile is up to date ($(cat "$stamp"))" >&2
+  exit 0
+fi
+
+# The counters accumulate over runs: a new profile starts from none. The stamp goes last, so a failed training leaves
+# no stamp (the release build then builds without a profile) rather than a partial profile under a stamp.
+rm -rf "$profile"
+mkdir -p "$profile"
+work=build/pgo-train/renders
+mkdir -p "$work"
+mapfile -t training < <(python3 - <<'PY'
+import json
+for g in json.load(open("tests/golden/goldens.json"))["goldens"]:
+    print(f'{g["name"]} {g["scene"]} --camera {g["camera"]} --time {g["time"]} --size 320x180')
+PY
+)
+training+=(
+  "d3d12.double scenes/d3d12-procedural-geometry.json --precision double --size 160x90"
+  "d3d12.perturbed scenes/d3d12-procedural-geometry.json --perturb 1 --size 160x90"
+  "cornell-box scenes/cornell-box.json --size 96x96"
+  "textured-room scenes/textured-room.json --size 96x96"
+)
+start=$SECONDS
+for line in "${training[@]}"; do
+  read -r name args <<< "$line"
+  echo "pgo_train: rendering $name" >&2
+  # shellcheck disable=SC2086  # the arguments are words
+  if ! "$binary" render $args --threads 1 -o "$work/$name.exr" > "$work/$name.log" 2>&1; then
+    echo "pgo_train: the training render $name failed (refray render $args):" >&2
+    cat "$work/$name.log" >&2
+    exit 1
+  fi
+done
+id=$(cd "$profile" && find . -name '*.gcda' -type f | LC_ALL=C sort | xargs sha256sum | sha256sum | cut -c1-16)
+echo "$id" > "$stamp"
+echo "pgo_train: profile $id in $profile ($(find "$profile" -name '*.gcda' | wc -l) files, $((SECONDS - start)) s of training)" >&2
