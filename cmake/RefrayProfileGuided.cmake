@@ -7,8 +7,10 @@
 # Neither changes an image: neither flag lets the compiler reassociate or contract floating-point operations
 # (-ffp-contract=off stays per function through LTO), so the renders are bit for bit the plain build's.
 # The profile's files are named relative to the build directory (-fprofile-prefix-path), so the instrumented build and
-# the optimised one, in two directories, meet on the same names. A new profile changes its stamp, which CMake
-# watches: the release build configures again and recompiles with it.
+# the optimised one, in two directories, meet on the same names. CMake watches the stamp: the first profile turns
+# the flags on (everything compiles again); a later one reaches the files that compile again for their own changes
+# (ccache keys on each file's counters), while the others keep what the profile before told GCC, which is as good
+# for code that did not change.
 set(REFRAY_PGO "OFF" CACHE STRING "Profile-guided optimisation: OFF, GENERATE (an instrumented build) or USE")
 set_property(CACHE REFRAY_PGO PROPERTY STRINGS OFF GENERATE USE)
 set(REFRAY_PGO_PROFILE "${CMAKE_SOURCE_DIR}/build/pgo-profile" CACHE PATH "The profile's directory (tools/pgo_train.sh)")
@@ -46,8 +48,6 @@ elseif(REFRAY_PGO STREQUAL "USE")
     # ReportHit's attributes whose size is the checked type's): false alarms of its whole-program view, which the
     # per-file checks of every other build (-Wall -Wextra, -Werror in `ci`) still run on the same code.
     add_link_options(-Wno-stringop-overflow -Wno-stringop-overread)
-    # The profile's identity on every compile line: a new profile recompiles, and ccache keys on it.
-    add_compile_definitions(REFRAY_PGO_PROFILE_ID=${refray_pgo_id})
     message(STATUS "refray: profile-guided (profile ${refray_pgo_id}) and link-time optimisation")
   else()
     message(STATUS "refray: no profile at ${REFRAY_PGO_PROFILE} (bash tools/pgo_train.sh makes one): building "

@@ -9,12 +9,11 @@ cd "$(dirname "$0")/.."
 bash tools/setup.sh >&2
 # The release build is profile-guided (cmake/RefrayProfileGuided.cmake): its profile first, made again only when the
 # instrumented build changed. REFRAY_PGO=0 skips it (the release build is then a plain -O3 build, slower to render).
-if [ "${REFRAY_PGO:-1}" != 0 ]; then
-  bash tools/pgo_train.sh
-fi
-if [ ! -f build/release/build.ninja ]; then
-  echo "refray.sh: configuring build/release" >&2
-  cmake --preset release >&2
+pgo=USE
+if [ "${REFRAY_PGO:-1}" = 0 ]; then pgo=OFF; else bash tools/pgo_train.sh; fi
+if [ ! -f build/release/build.ninja ] || ! grep -qx "REFRAY_PGO:STRING=$pgo" build/release/CMakeCache.txt; then
+  echo "refray.sh: configuring build/release (REFRAY_PGO=$pgo)" >&2
+  cmake --preset release -DREFRAY_PGO="$pgo" >&2
 fi
 echo "refray.sh: building (first time: several minutes on 2 cores)" >&2
 cmake --build build/release --target refray -j "$(nproc)" >&2
