@@ -2,10 +2,10 @@
 # The release build's profile (cmake/RefrayProfileGuided.cmake, docs/performance.md "Profile-guided and link-time
 # optimisation"): builds the instrumented `pgo-train` preset's refray, renders the training set with it, and writes
 # the profile to build/pgo-profile: GCC's counters and profile.stamp, their hash, which the release build reads (a
-# new stamp makes it configure again and recompile). The training set: every golden setting of
-# tests/golden/goldens.json at 320x180, a double and a perturbed render (the envelope goldens' precisions) and the
-# path tracer's two scenes, small, on one thread (the counters, and so the profile and the compiled objects that
-# ccache keeps, are then the same on every run). About a minute on 2 cores once built.
+# new stamp makes it configure again; the first one compiles everything with the profile). The training set: every
+# golden setting of tests/golden/goldens.json at 320x180, a double and a perturbed render (the envelope goldens'
+# precisions) and the path tracer's two scenes, small, on one thread. About 20 s once built. The counters differ a
+# little from run to run (hash tables keyed by addresses), so what compiles after a new training misses ccache.
 # It renders again only when the instrumented refray is newer than the stamp, or with --force.
 #   bash tools/pgo_train.sh [--force]
 # Exit status: 0 (a profile is there), 1 (a build or a training render failed: the message says which), 2 (usage).
