@@ -8,9 +8,10 @@
 # (-ffp-contract=off stays per function through LTO), so the renders are bit for bit the plain build's.
 # The profile's files are named relative to the build directory (-fprofile-prefix-path), so the instrumented build and
 # the optimised one, in two directories, meet on the same names. CMake watches the stamp: the first profile turns
-# the flags on (everything compiles again); a later one reaches the files that compile again for their own changes
-# (ccache keys on each file's counters), while the others keep what the profile before told GCC, which is as good
-# for code that did not change.
+# the flags on (everything compiles again); a later one reaches the files that compile again for their own changes,
+# while the others keep what the profile before told GCC, which is as good for code that did not change.
+# ccache (4.8) caches neither build: it counts -fprofile-update and -fprofile-prefix-path as unsupported options and
+# hands those compilations to GCC.
 set(REFRAY_PGO "OFF" CACHE STRING "Profile-guided optimisation: OFF, GENERATE (an instrumented build) or USE")
 set_property(CACHE REFRAY_PGO PROPERTY STRINGS OFF GENERATE USE)
 set(REFRAY_PGO_PROFILE "${CMAKE_SOURCE_DIR}/build/pgo-profile" CACHE PATH "The profile's directory (tools/pgo_train.sh)")

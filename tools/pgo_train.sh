@@ -5,7 +5,8 @@
 # new stamp makes it configure again; the first one compiles everything with the profile). The training set: every
 # golden setting of tests/golden/goldens.json at 320x180, a double and a perturbed render (the envelope goldens'
 # precisions) and the path tracer's two scenes, small, on one thread. About 20 s once built. The counters differ a
-# little from run to run (hash tables keyed by addresses), so what compiles after a new training misses ccache.
+# little from run to run (hash tables keyed by addresses). ccache caches neither this build nor the release build
+# (cmake/RefrayProfileGuided.cmake), so a fresh clone compiles both.
 # It renders again only when the instrumented refray is newer than the stamp, or with --force.
 #   bash tools/pgo_train.sh [--force]
 # Exit status: 0 (a profile is there), 1 (a build or a training render failed: the message says which), 2 (usage).
