@@ -10,7 +10,7 @@
 # the optimised one, in two directories, meet on the same names. CMake watches the stamp: the first profile turns
 # the flags on (everything compiles again); a later one reaches the files that compile again for their own changes,
 # while the others keep what the profile before told GCC, which is as good for code that did not change.
-# ccache (4.8) caches neither build: it counts -fprofile-update and -fprofile-prefix-path as unsupported options and
+# ccache (4.7) caches neither build: it counts -fprofile-update and -fprofile-prefix-path as unsupported options and
 # hands those compilations to GCC.
 set(REFRAY_PGO "OFF" CACHE STRING "Profile-guided optimisation: OFF, GENERATE (an instrumented build) or USE")
 set_property(CACHE REFRAY_PGO PROPERTY STRINGS OFF GENERATE USE)
