@@ -4,6 +4,8 @@
   gpu_crosscheck.py plan ROOT SIZE          what to render: one tab-separated line per render
                                             (what, name, scene, camera, time, size, precision, aov, output,
                                             extra refray arguments or "-")
+  gpu_crosscheck.py settings ROOT           every golden's setting, a line each: name, scene, camera, time
+                                            (tools/lavapipe_speed.sh and tools/pgo_train.sh render them)
   gpu_crosscheck.py metadata FILE.exr       the refray:* attributes of an EXR's header, as JSON
   gpu_crosscheck.py provenance DIR          writes DIR/provenance.json from DIR/plan.tsv, DIR/commands.txt,
                                             DIR/speed.tsv and the renders' headers
@@ -31,6 +33,11 @@ def aovs_of(root, scene):
     if desc.get("pipeline", {}).get("compute"):
         return [a for a in AOVS if a not in ("record", "hitgroup")]
     return AOVS
+
+
+def settings(root):
+    for g in json.load(open(os.path.join(root, "tests/golden/goldens.json")))["goldens"]:
+        print(g["name"], g["scene"], g["camera"], g["time"])
 
 
 def plan(root, size):
@@ -144,6 +151,8 @@ def provenance(directory):
 if __name__ == "__main__":
     if len(sys.argv) == 4 and sys.argv[1] == "plan":
         plan(sys.argv[2], sys.argv[3])
+    elif len(sys.argv) == 3 and sys.argv[1] == "settings":
+        settings(sys.argv[2])
     elif len(sys.argv) == 3 and sys.argv[1] == "metadata":
         print(json.dumps(exr_attributes(sys.argv[2]), indent=1))
     elif len(sys.argv) == 3 and sys.argv[1] == "provenance":

@@ -38,12 +38,7 @@ out=$work/table.md
 export LP_NUM_THREADS=$threads  # llvmpipe's rasterizer/compute threads: the same count as refray's
 
 # Every golden setting: NAME SCENE CAMERA TIME.
-mapfile -t settings < <(python3 - <<'PY'
-import json
-for g in json.load(open("tests/golden/goldens.json"))["goldens"]:
-    print(g["name"], g["scene"], g["camera"], g["time"])
-PY
-)
+mapfile -t settings < <(python3 tools/gpu_crosscheck.py settings .)
 
 # run_once DEVICE NAME SCENE CAMERA TIME: sets $trace (the image's render_seconds: refray's DispatchRays wall time,
 # or on lavapipe the vkCmdTraceRaysKHR time from its timestamps) and $process (the whole command's wall time).

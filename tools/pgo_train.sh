@@ -40,12 +40,8 @@ rm -rf "$profile"
 mkdir -p "$profile"
 work=build/pgo-train/renders
 mkdir -p "$work"
-mapfile -t training < <(python3 - <<'PY'
-import json
-for g in json.load(open("tests/golden/goldens.json"))["goldens"]:
-    print(f'{g["name"]} {g["scene"]} --camera {g["camera"]} --time {g["time"]} --size 320x180')
-PY
-)
+mapfile -t training < <(python3 tools/gpu_crosscheck.py settings . |
+                         awk '{print $1, $2, "--camera", $3, "--time", $4, "--size 320x180"}')
 training+=(
   "d3d12.double scenes/d3d12-procedural-geometry.json --precision double --size 160x90"
   "d3d12.perturbed scenes/d3d12-procedural-geometry.json --perturb 1 --size 160x90"
