@@ -369,14 +369,18 @@ PrimitiveHit<T> IntersectPrimitive(IntersectionShader shader, uint32_t primitive
 }
 
 // The SignedDistancePrimitive test (RaySignedDistancePrimitiveTest) for up to kMaxWaveWidth rays of one primitive
-// type over WaveLanes<float>, refilled as rays stop (math::RaySignedDistancePrimitiveTestQueue): out[k] is bit for
-// bit IntersectPrimitive<float>'s hit for ray k. What a record group of the intersection shader, and a wave call of
-// inline ray tracing, run for their lanes.
+// type over 16 float lanes, refilled as rays stop, the last 8 or fewer rays over 8 (math::
+// RaySignedDistancePrimitiveTestQueue): out[k] is bit for bit IntersectPrimitive<float>'s hit for ray k. What a
+// record group of the intersection shader, and a wave call of inline ray tracing, run for their lanes.
+// PORT: 16 lanes, not WaveLanes' 8: the sphere tracing is one chain of dependent instructions a step (the fractal
+// pyramid's iterations above all), and a 16-float step is two independent 8-float chains that the core overlaps;
+// a queue of 26 rays a call on average (the D3D12 view) keeps 16 lanes busy until its last 8 rays.
 void SignedDistanceQueue(uint32_t primitiveType, const Accuracy& accuracy, const math::SphereTraceRay<float>* rays,
                          int count, PrimitiveHit<float>* out) {
-    using L = WaveLanes<float>;
+    using L = math::Lanes<float, 16>;
     [[maybe_unused]] PrecisionScope<L> scope;
-    const auto sdf = [primitiveType](const tvec3<L>& position) {
+    // Over 16 lanes, and over 8 for the queue's tail.
+    const auto sdf = [primitiveType](const auto& position) {
         return math::d3d12::GetDistanceFromSignedDistancePrimitive(position, SignedDistancePrimitive(primitiveType));
     };
     std::array<math::SphereTraceResult<float>, kMaxWaveWidth> results;

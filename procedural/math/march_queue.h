@@ -6,6 +6,7 @@
 // PORT: not in the HLSL; a GPU runs a wave's marches in its lanes, each lane until its own ray ends.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <bit>
 
@@ -16,20 +17,22 @@ namespace refray::procedural::math {
 // The most rays a march queue takes: a wave's (32).
 inline constexpr int kMaxMarchQueue = 32;
 
-// Marches rays 0..count-1 over the N lanes of L, each for at most maxSteps steps (none when maxSteps <= 0):
-// - marches(k): whether ray k marches at all (a ray that does not keeps the state it starts with);
-// - load(j, k): puts ray k's inputs and march state into lane j;
-// - step(running): one march step over the lanes, which clears `running` for the lanes whose ray stops;
-// - store(j, k): takes lane j's march state back to ray k, once its ray stopped or took its last step.
-// The lanes with no ray hold the first ray's inputs (load of that ray again), so that their math stays sane; they
-// never run and are never stored.
-template <class L, class Marches, class Load, class Step, class Store>
-void marchQueue(int count, int maxSteps, Marches&& marches, Load&& load, Step&& step, Store&& store) {
+// marchQueue that may leave early, for a narrower march to finish: once the queue is empty and at most `leaveAt`
+// lanes still march, it stores their rays' state (store) and returns the rays that have not stopped, bit k for ray
+// k (0 when every ray ran to its end). taken(k) is how many steps ray k took before (a resumed march): it has
+// maxSteps - taken(k) left.
+template <class L, class Marches, class Load, class Step, class Store, class Taken>
+uint32_t marchQueueUntil(int count, int maxSteps, Marches&& marches, Load&& load, Step&& step, Store&& store,
+                         int leaveAt, Taken&& taken) {
     constexpr int N = L::kCount;
-    if (maxSteps <= 0) return;
+    static_assert(N <= 32, "a march queue's lanes are bits of a 32-bit mask");
+    if (maxSteps <= 0) return 0;
     LaneMask<L> running(false);
     std::array<int, size_t(N)> ray{};  // the ray each lane marches
-    std::array<int, size_t(N)> steps{};
+    // A lane's ray has taken its last step once the queue's step count reaches the lane's deadline: the count when
+    // the ray came in, plus the steps it has left (every running lane steps at every step of the queue).
+    std::array<long long, size_t(N)> deadline{};
+    long long stepsTaken = 0, nearestDeadline = maxSteps;
     int next = 0;
     // The next ray that marches into lane j; or, when the queue is empty, the lane left out.
     const auto fill = [&](int j) {
@@ -39,26 +42,58 @@ void marchQueue(int count, int maxSteps, Marches&& marches, Load&& load, Step&& 
             return;
         }
         ray[size_t(j)] = next;
-        steps[size_t(j)] = 0;
+        deadline[size_t(j)] = stepsTaken + maxSteps - taken(next);
+        nearestDeadline = std::min(nearestDeadline, deadline[size_t(j)]);
         load(j, next++);
         setLane(running, j, true);
     };
     for (int j = 0; j < N; ++j) fill(j);
     const int first = std::countr_zero(laneBits(running));  // 32 when no ray marches
-    if (first >= N) return;
+    if (first >= N) return 0;
     for (int j = 0; j < N; ++j)
         if (!lane(running, j)) load(j, ray[size_t(first)]);
     const LiveLanes queueLanes(laneBits(LaneMask<L>(true)), 0);  // the queue's lanes, whatever encloses it
-    while (anyLane(running)) {
-        const LaneMask<L> stepped = running;
+    // Per step, the lanes whose ray stopped come from the masks (a few instructions), not from a pass over the lanes.
+    for (uint32_t stepped = laneBits(running); stepped; stepped = laneBits(running)) {
+        if (next == count && std::popcount(stepped) <= leaveAt) {  // a narrower march takes the rest
+            uint32_t left = 0;
+            for (uint32_t live = stepped; live; live &= live - 1) {
+                const int j = std::countr_zero(live);
+                store(j, ray[size_t(j)]);
+                left |= 1u << ray[size_t(j)];
+            }
+            return left;
+        }
         step(running);
-        for (int j = 0; j < N; ++j) {
-            if (!lane(stepped, j)) continue;
-            if (lane(running, j) && ++steps[size_t(j)] < maxSteps) continue;
+        ++stepsTaken;
+        uint32_t stopped = stepped & ~laneBits(running);
+        if (stepsTaken >= nearestDeadline) {  // some running ray may have taken its last step
+            nearestDeadline = stepsTaken + maxSteps;
+            for (uint32_t live = stepped & ~stopped; live; live &= live - 1) {
+                const int j = std::countr_zero(live);
+                if (deadline[size_t(j)] <= stepsTaken) stopped |= 1u << j;
+                else nearestDeadline = std::min(nearestDeadline, deadline[size_t(j)]);
+            }
+        }
+        for (; stopped; stopped &= stopped - 1) {
+            const int j = std::countr_zero(stopped);
             store(j, ray[size_t(j)]);  // the ray stopped, or took its last step
             fill(j);
         }
     }
+    return 0;
+}
+
+// Marches rays 0..count-1 over the N lanes of L, each for at most maxSteps steps (none when maxSteps <= 0):
+// - marches(k): whether ray k marches at all (a ray that does not keeps the state it starts with);
+// - load(j, k): puts ray k's inputs and march state into lane j;
+// - step(running): one march step over the lanes, which clears `running` for the lanes whose ray stops;
+// - store(j, k): takes lane j's march state back to ray k, once its ray stopped or took its last step.
+// The lanes with no ray hold the first ray's inputs (load of that ray again), so that their math stays sane; they
+// never run and are never stored.
+template <class L, class Marches, class Load, class Step, class Store>
+void marchQueue(int count, int maxSteps, Marches&& marches, Load&& load, Step&& step, Store&& store) {
+    marchQueueUntil<L>(count, maxSteps, marches, load, step, store, 0, [](int) { return 0; });
 }
 
 }  // namespace refray::procedural::math

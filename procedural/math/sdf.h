@@ -343,30 +343,28 @@ struct SphereTraceRay {
     S stepScale = S(1);
 };
 
-// RaySignedDistancePrimitiveTest for `count` (at most kMaxMarchQueue) rays in S over the lanes of L = Lanes<S, N>,
-// refilled from the queue as rays stop (march_queue.h): out[k] is bit for bit
-// RaySignedDistancePrimitiveTest(rays[k].ray, rays[k].extent, sdf, params with rays[k].stepScale) in S. `sdf` runs
-// over L; params' threshold, maxSteps and normalOffset are every ray's (its stepScale is not read).
-// PORT: not in the HLSL; a GPU runs a wave's sphere tracing in its lanes, each lane until its own ray ends.
+namespace detail {
+
+// One pass of RaySignedDistancePrimitiveTestQueue over the lanes of L for the rays of `marching` (bit k for ray k),
+// from and back to their state in `march`; returns the rays left for a narrower pass (marchQueueUntil's leaveAt).
 template <class L, class Sdf, class S = typename L::Scalar>
-void RaySignedDistancePrimitiveTestQueue(const SphereTraceRay<S>* rays, int count, Sdf&& sdf,
-                                         const SphereTraceParams<S>& params, SphereTraceResult<S>* out) {
-    std::array<SphereTraceMarch<S>, kMaxMarchQueue> march{};
-    for (int k = 0; k < count; ++k) march[size_t(k)].t = rays[k].extent.tMin;  // where a ray that never steps stays
+uint32_t sphereTraceQueuePass(const SphereTraceRay<S>* rays, int count, uint32_t marching, Sdf& sdf,
+                              const SphereTraceParams<S>& params, SphereTraceMarch<S>* march, int leaveAt) {
     Ray<L> ray;
     RayExtent<L> extent;
     SphereTraceParams<L> laneParams;
     laneParams.threshold = L(params.threshold);
     laneParams.normalOffset = L(params.normalOffset);
     SphereTraceMarch<L> m;
-    marchQueue<L>(
-        count, int(std::min<std::uint32_t>(params.maxSteps, std::uint32_t(1) << 30)), [](int) { return true; },
+    return marchQueueUntil<L>(
+        count, int(std::min<std::uint32_t>(params.maxSteps, std::uint32_t(1) << 30)),
+        [marching](int k) { return (marching >> k & 1u) != 0; },
         [&](int j, int k) {
             const SphereTraceRay<S>& r = rays[k];
             setLane(ray, j, r.ray);
             setLane(extent, j, r.extent);
             setLane(laneParams.stepScale, j, r.stepScale);
-            const SphereTraceMarch<S>& from = march[size_t(k)];
+            const SphereTraceMarch<S>& from = march[k];
             setLane(m.t, j, from.t);
             setLane(m.result.hit, j, bool(from.result.hit));
             setLane(m.result.thit, j, from.result.thit);
@@ -379,14 +377,43 @@ void RaySignedDistancePrimitiveTestQueue(const SphereTraceRay<S>* rays, int coun
             sphereTraceStep(ray, extent, sdf, laneParams, m.result.steps + LaneUint<L>(1u), m, running);
         },
         [&](int j, int k) {
-            SphereTraceMarch<S>& to = march[size_t(k)];
+            SphereTraceMarch<S>& to = march[k];
             to.t = lane(m.t, j);
             to.result.hit = lane(m.result.hit, j);
             to.result.thit = lane(m.result.thit, j);
             to.result.normal = lane(m.result.normal, j);
             to.result.position = lane(m.result.position, j);
             to.result.steps = lane(m.result.steps, j);
-        });
+        },
+        leaveAt,
+        // A ray that still marches counted each of its steps (result.steps is the iteration it is at).
+        [march](int k) { return int(march[k].result.steps); });
+}
+
+}  // namespace detail
+
+// RaySignedDistancePrimitiveTest for `count` (at most kMaxMarchQueue) rays in S over the lanes of L = Lanes<S, N>,
+// refilled from the queue as rays stop (march_queue.h): out[k] is bit for bit
+// RaySignedDistancePrimitiveTest(rays[k].ray, rays[k].extent, sdf, params with rays[k].stepScale) in S. `sdf` runs
+// over the lanes (a generic callable: over L, and over Lanes<S, 8> for the tail below); params' threshold, maxSteps
+// and normalOffset are every ray's (its stepScale is not read).
+// Over more than 8 lanes, the rays that still march once the queue is empty and 8 or fewer remain go on in 8 lanes
+// (Lanes<S, 8>): an 8-lane step costs less than a wide one (on AVX-512 a 16-float instruction is two 8-float
+// halves), and a resumed ray takes the steps it would have taken, from the state it stopped at.
+// PORT: not in the HLSL; a GPU runs a wave's sphere tracing in its lanes, each lane until its own ray ends.
+template <class L, class Sdf, class S = typename L::Scalar>
+void RaySignedDistancePrimitiveTestQueue(const SphereTraceRay<S>* rays, int count, Sdf&& sdf,
+                                         const SphereTraceParams<S>& params, SphereTraceResult<S>* out) {
+    std::array<SphereTraceMarch<S>, kMaxMarchQueue> march{};
+    for (int k = 0; k < count; ++k) march[size_t(k)].t = rays[k].extent.tMin;  // where a ray that never steps stays
+    const uint32_t all = count >= 32 ? ~0u : (1u << count) - 1u;
+    constexpr int kNarrow = 8;
+    if constexpr (L::kCount > kNarrow) {
+        const uint32_t left = detail::sphereTraceQueuePass<L>(rays, count, all, sdf, params, march.data(), kNarrow);
+        if (left) detail::sphereTraceQueuePass<Lanes<S, kNarrow>>(rays, count, left, sdf, params, march.data(), 0);
+    } else {
+        detail::sphereTraceQueuePass<L>(rays, count, all, sdf, params, march.data(), 0);
+    }
     for (int k = 0; k < count; ++k) out[k] = march[size_t(k)].result;
 }
 

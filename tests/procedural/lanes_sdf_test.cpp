@@ -192,19 +192,31 @@ void forGroups(const std::vector<RayIn>& rays, uint64_t seed, Check check) {
 
 // ---- The tests ----------------------------------------------------------------------------------------------------
 // The six D3D12 SDFs (the switch cases of GetDistanceFromSignedDistancePrimitive) as sphere-tracing callbacks.
+using L8 = Lanes<float, 8>;
 struct NamedSdf {
     const char* name;
     float (*scalar)(const vec3<float>&);
     L (*lanes)(const vec3<L>&);
+    L8 (*lanes8)(const vec3<L8>&);  // a queue wider than 8 lanes finishes its last rays over 8
+    // Over L, or over 8 lanes: what a march queue calls.
+    auto queued() const {
+        return [this](const auto& p) {
+            if constexpr (std::is_same_v<std::decay_t<decltype(p)>, vec3<L>>) return lanes(p);
+            else return lanes8(p);
+        };
+    }
 };
+// Each SDF over float, over the test's lanes and over 8.
+#define REFRAY_SDF(name, fn) {name, fn<float>, fn<L>, fn<L8>}
 const NamedSdf kSdfs[] = {
-    {"MiniSpheres", d3d12::sdMiniSpheres<float>, d3d12::sdMiniSpheres<L>},
-    {"IntersectedRoundCube", d3d12::sdIntersectedRoundCube<float>, d3d12::sdIntersectedRoundCube<L>},
-    {"SquareTorus", d3d12::sdSquareTorus<float>, d3d12::sdSquareTorus<L>},
-    {"TwistedTorus", d3d12::sdTwistedTorus<float>, d3d12::sdTwistedTorus<L>},
-    {"Cog", d3d12::sdCog<float>, d3d12::sdCog<L>},
-    {"CylinderColumns", d3d12::sdCylinderColumns<float>, d3d12::sdCylinderColumns<L>},
+    REFRAY_SDF("MiniSpheres", d3d12::sdMiniSpheres),
+    REFRAY_SDF("IntersectedRoundCube", d3d12::sdIntersectedRoundCube),
+    REFRAY_SDF("SquareTorus", d3d12::sdSquareTorus),
+    REFRAY_SDF("TwistedTorus", d3d12::sdTwistedTorus),
+    REFRAY_SDF("Cog", d3d12::sdCog),
+    REFRAY_SDF("CylinderColumns", d3d12::sdCylinderColumns),
 };
+#undef REFRAY_SDF
 
 TEST(LanesSdf, SphereTracingMatchesScalarPerLane) {
     const std::vector<RayIn> rays = makeRays(0x5DF, 16 * 12, 0.5f, 1.0f);  // param: the material's stepScale
@@ -238,9 +250,9 @@ TEST(LanesSdf, SphereTracingMatchesScalarPerLane) {
 }
 
 TEST(LanesSdf, SphereTracingQueuesGiveEachRayItsScalarResult) {
-    // RaySignedDistancePrimitiveTestQueue refills its W lanes from a queue of up to 16 rays: every ray's result (hit,
-    // t, normal, position, step count) is bit for bit its one-ray RaySignedDistancePrimitiveTest, for every queue
-    // length 1..16, with each ray's own stepScale, rays that hit, miss, start beyond RayTCurrent, run out of steps
+    // RaySignedDistancePrimitiveTestQueue refills its W lanes from a queue of up to 32 rays (over 16 lanes, its last 8
+    // or fewer rays go on over 8, from where they stopped): every ray's result (hit, t, normal, position, step count)
+    // is bit for bit its one-ray RaySignedDistancePrimitiveTest, for every queue length 1..32, with each ray's own stepScale, rays that hit, miss, start beyond RayTCurrent, run out of steps
     // (the coarse and one-step accuracies), and rays of NaN and infinite values.
     std::vector<RayIn> rays = makeRays(0x9E5, 16 * 10, 0.5f, 1.0f);
     Rng rng{0x77};
@@ -266,7 +278,7 @@ TEST(LanesSdf, SphereTracingQueuesGiveEachRayItsScalarResult) {
                     queue.push_back({scalarRay(r), scalarExtent(r), r.param});
                 }
                 std::vector<SphereTraceResult<float>> got(static_cast<size_t>(n));
-                RaySignedDistancePrimitiveTestQueue<L>(queue.data(), n, sdf.lanes, params, got.data());
+                RaySignedDistancePrimitiveTestQueue<L>(queue.data(), n, sdf.queued(), params, got.data());
                 ++queues;
                 for (int k = 0; k < n; ++k) {
                     const RayIn& r = rays[first + size_t(k)];
