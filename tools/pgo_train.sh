@@ -7,7 +7,9 @@
 # precisions) and the path tracer's two scenes, small, on one thread. About 20 s once built. The counters differ a
 # little from run to run (hash tables keyed by addresses). ccache caches neither this build nor the release build
 # (cmake/RefrayProfileGuided.cmake), so a fresh clone compiles both.
-# It renders again only when the instrumented refray is newer than the stamp, or with --force.
+# It renders again only when the instrumented build's objects changed since the last training (their hash, less the
+# objects that hold the commit (tools/version.h), which every commit rebuilds without changing what they run), or with
+# --force.
 #   bash tools/pgo_train.sh [--force]
 # Exit status: 0 (a profile is there), 1 (a build or a training render failed: the message says which), 2 (usage).
 set -euo pipefail
@@ -16,12 +18,23 @@ force=0
 case "${1:-}" in
   "") ;;
   --force) force=1 ;;
-  -h|--help) sed -n '2,11p' "$0"; exit 0 ;;
+  -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
   *) echo "pgo_train: unknown argument '$1' (--force)" >&2; exit 2 ;;
 esac
 profile=build/pgo-profile
 stamp=$profile/profile.stamp
+objects_hash=$profile/objects.sha256
 binary=build/pgo-train/tools/refray
+
+# The hash of the instrumented build's objects, less the ones that include the generated tools/version.h (ninja's
+# record of each object's headers says which).
+objects_fingerprint() {
+  local versioned
+  versioned=$(ninja -C build/pgo-train -t deps | awk '/^[^ ].*: #deps/ {obj = $1; sub(/:$/, "", obj)}
+                                                      /generated\/tools\/version\.h/ {print obj}' | sort -u)
+  (cd build/pgo-train && find . -name '*.o' -type f | sed 's|^\./||' | LC_ALL=C sort |
+     grep -vxF -f <(printf '%s\n' "$versioned" | grep .) | xargs sha256sum | sha256sum | cut -c1-16)
+}
 
 if [ ! -f build/pgo-train/build.ninja ]; then
   echo "pgo_train: configuring build/pgo-train (the instrumented build)" >&2
@@ -29,8 +42,9 @@ if [ ! -f build/pgo-train/build.ninja ]; then
 fi
 echo "pgo_train: building the instrumented refray" >&2
 cmake --build --preset pgo-train -j "$(nproc)" >&2
-if [ "$force" = 0 ] && [ -f "$stamp" ] && [ "$stamp" -nt "$binary" ]; then
-  echo "pgo_train: the profile is up to date ($(cat "$stamp"))" >&2
+fingerprint=$(objects_fingerprint)
+if [ "$force" = 0 ] && [ -f "$stamp" ] && [ "$(cat "$objects_hash" 2>/dev/null)" = "$fingerprint" ]; then
+  echo "pgo_train: the profile is up to date ($(cat "$stamp"); the instrumented objects did not change)" >&2
   exit 0
 fi
 
@@ -60,5 +74,6 @@ for line in "${training[@]}"; do
   fi
 done
 id=$(cd "$profile" && find . -name '*.gcda' -type f | LC_ALL=C sort | xargs sha256sum | sha256sum | cut -c1-16)
+echo "$fingerprint" > "$objects_hash"
 echo "$id" > "$stamp"
 echo "pgo_train: profile $id in $profile ($(find "$profile" -name '*.gcda' | wc -l) files, $((SECONDS - start)) s of training)" >&2
