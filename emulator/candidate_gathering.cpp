@@ -50,19 +50,25 @@ GatherMode traversalMode(const ThreadState& ts, const RayState& rs) {
 
 // Orders candidates per DispatchOptions::order (GEN-3).
 void orderCandidates(ThreadState& ts, RayState& rs, std::vector<Candidate>& cs) {
-    std::sort(cs.begin(), cs.end(), [](const Candidate& a, const Candidate& b) {
+    const auto before = [](const Candidate& a, const Candidate& b) {
         if (a.key != b.key) return a.key < b.key;
         if (a.instanceIndex != b.instanceIndex) return a.instanceIndex < b.instanceIndex;
         if (a.geometryIndex != b.geometryIndex) return a.geometryIndex < b.geometryIndex;
         return a.primitiveIndex < b.primitiveIndex;
-    });
+    };
     // One candidate per primitive: Embree may report a primitive more than once (AHS-6, IS-1).
-    cs.erase(std::unique(cs.begin(), cs.end(),
-                         [](const Candidate& a, const Candidate& b) {
-                             return a.instanceIndex == b.instanceIndex && a.geometryIndex == b.geometryIndex &&
-                                    a.primitiveIndex == b.primitiveIndex;
-                         }),
-             cs.end());
+    const auto samePrimitive = [](const Candidate& a, const Candidate& b) {
+        return a.instanceIndex == b.instanceIndex && a.geometryIndex == b.geometryIndex &&
+               a.primitiveIndex == b.primitiveIndex;
+    };
+    // Most rays meet one or two candidates (1.26 a ray on the D3D12 view): those without std::sort and std::unique.
+    if (cs.size() == 2) {
+        if (before(cs[1], cs[0])) std::swap(cs[0], cs[1]);
+        if (samePrimitive(cs[0], cs[1])) cs.pop_back();
+    } else if (cs.size() > 2) {
+        std::sort(cs.begin(), cs.end(), before);
+        cs.erase(std::unique(cs.begin(), cs.end(), samePrimitive), cs.end());
+    }
     if (ts.dispatch->options.order != TraversalOrder::Adversarial) return;
 
     std::mt19937_64 rng(ts.dispatch->options.adversarialSeed * 0x9E3779B97F4A7C15ull ^ (ts.linearIndex << 20) ^
