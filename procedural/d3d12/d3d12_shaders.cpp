@@ -391,9 +391,12 @@ void SignedDistanceQueue(uint32_t primitiveType, const Accuracy& accuracy, const
 // Inline ray tracing's IntersectPrimitive, run once over the lanes of a wave that intersect a procedural candidate
 // of the same kind (dxr::ShaderContext::callInWave, emulator/wave_call.h), as the TraceRay version's intersection
 // shaders run over a record group: the shader, primitive type and Accuracy are the call's key; each lane's ray,
-// extent, time and step scale are its own. A call of one lane runs in float, more in WaveLanes<float> (the lanes no
-// ray fills hold the first lane's values): each lane's hit is bit for bit the one-lane result. double and
-// PerturbedFloat run alone, for withLaneType's reasons.
+// extent, time and step scale are its own. A call of one lane runs in float, of up to 8 in WaveLanes<float>, of up to
+// 16 in 16 float lanes (the lanes no ray fills hold the first lane's values): each lane's hit is bit for bit the
+// one-lane result. double and PerturbedFloat run alone, for withLaneType's reasons.
+// PORT: up to 16 lanes a call for the metaballs' march (the ambient-occlusion view's costliest test after the
+// pyramid): its 128 samples are one latency-bound chain a ray, all rays take them all, and 16 float lanes, two
+// independent 8-float halves, cost about 1.2 times 8 for twice the rays.
 struct PrimitiveCall {
     IntersectionShader shader = IntersectionShader::AnalyticPrimitive;
     uint32_t primitiveType = 0;
@@ -404,22 +407,17 @@ struct PrimitiveCall {
     PrimitiveHit<float> result;
 };
 
-void runPrimitiveCalls(std::span<void* const> lanes) {
+// The calls of `lanes` over the lanes of L.
+template <class L>
+void runPrimitiveCallsIn(std::span<void* const> lanes) {
     const auto call = [&lanes](size_t i) -> PrimitiveCall& { return *static_cast<PrimitiveCall*>(lanes[i]); };
     const PrimitiveCall& first = call(0);
-    if (lanes.size() == 1) {
-        [[maybe_unused]] PrecisionScope<float> scope;
-        call(0).result = IntersectPrimitive<float>(first.shader, first.primitiveType, first.localRay, first.extent,
-                                                   first.elapsedTime, first.stepScale, *first.accuracy);
-        return;
-    }
-    using L = WaveLanes<float>;
     [[maybe_unused]] PrecisionScope<L> scope;
     const math::LiveLanes live(uint32_t(dxr::LaneMask::first(int(lanes.size())).bits()), 0);
     math::Ray<L> localRay;
     math::RayExtent<L> extent;
     L elapsedTime, stepScale;
-    for (int i = 0; i < kWaveLanes; ++i) {
+    for (int i = 0; i < L::kCount; ++i) {
         const PrimitiveCall& c = size_t(i) < lanes.size() ? call(size_t(i)) : first;
         math::setLane(localRay, i, c.localRay);
         math::setLane(extent, i, c.extent);
@@ -436,7 +434,19 @@ void runPrimitiveCalls(std::span<void* const> lanes) {
     }
 }
 
-inline constexpr dxr::WaveFunction kPrimitiveCalls{runPrimitiveCalls, kWaveLanes};
+void runPrimitiveCalls(std::span<void* const> lanes) {
+    if (lanes.size() == 1) {
+        PrimitiveCall& c = *static_cast<PrimitiveCall*>(lanes[0]);
+        [[maybe_unused]] PrecisionScope<float> scope;
+        c.result = IntersectPrimitive<float>(c.shader, c.primitiveType, c.localRay, c.extent, c.elapsedTime,
+                                             c.stepScale, *c.accuracy);
+        return;
+    }
+    if (lanes.size() <= size_t(kWaveLanes)) return runPrimitiveCallsIn<WaveLanes<float>>(lanes);
+    runPrimitiveCallsIn<math::Lanes<float, 16>>(lanes);
+}
+
+inline constexpr dxr::WaveFunction kPrimitiveCalls{runPrimitiveCalls, 16};
 
 // The SignedDistancePrimitive calls of a wave: a whole wave's lanes a call, through SignedDistanceQueue (one lane
 // alone in float, as runPrimitiveCalls).
