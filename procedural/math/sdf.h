@@ -282,12 +282,32 @@ struct SphereTraceMarch {
     SphereTraceResult<T> result;
 };
 
+// The candidate part of RaySignedDistancePrimitiveTest's loop body, for the lanes of `candidate` (a subset of
+// `running`) at `position`: the normal, IsAValidHit, and for an accepted hit the result, and the ray out of `running`.
+template <typename T, class Sdf>
+void sphereTraceCandidate(const Ray<T>& ray, const RayExtent<T>& extent, Sdf& sdf, const SphereTraceParams<T>& params,
+                          const LaneMask<T>& candidate, const vec3<T>& position, SphereTraceMarch<T>& m,
+                          LaneMask<T>& running) {
+    SphereTraceResult<T>& result = m.result;
+    const vec3<T> hitSurfaceNormal = sdCalculateNormal(position, sdf, params.normalOffset);
+    const LaneMask<T> accepted = candidate && IsAValidHit(ray, m.t, hitSurfaceNormal, extent);
+    // if (IsAValidHit(...)) { ...; return true; }
+    result.hit = result.hit || accepted;
+    result.thit = select(accepted, m.t, result.thit);
+    result.normal = select(accepted, hitSurfaceNormal, result.normal);
+    result.position = select(accepted, position, result.position);
+    running = running && !accepted;
+}
+
 // One pass of RaySignedDistancePrimitiveTest's loop body for the rays of `running`, as iteration `i` (1-based; the
 // loop's `i++ < maxSteps` is the caller's): a ray beyond RayTCurrent leaves `running`, as does a ray whose hit is
-// accepted.
+// accepted. Given `candidates` (a march queue's), a candidate hit is not judged here: the ray leaves `running`
+// with its bit set in `candidates` and its distance in `candidateDistance`, t where it stands, for
+// sphereTraceCandidate and the step's end (t += stepScale * distance if rejected) to run later with other rays'.
 template <typename T, class Sdf>
 void sphereTraceStep(const Ray<T>& ray, const RayExtent<T>& extent, Sdf& sdf, const SphereTraceParams<T>& params,
-                     const LaneUint<T>& i, SphereTraceMarch<T>& m, LaneMask<T>& running) {
+                     const LaneUint<T>& i, SphereTraceMarch<T>& m, LaneMask<T>& running,
+                     LaneMask<T>* candidates = nullptr, T* candidateDistance = nullptr) {
     running = running && m.t <= extent.tCurrent;  // PORT: the loop's `&& t <= RayTCurrent()`, per ray
     if (!anyLane(running)) return;
     const LiveLanes live(running);
@@ -298,14 +318,13 @@ void sphereTraceStep(const Ray<T>& ray, const RayExtent<T>& extent, Sdf& sdf, co
 
     const LaneMask<T> candidate = running && distance <= params.threshold * m.t;
     if (anyLane(candidate)) {
-        const vec3<T> hitSurfaceNormal = sdCalculateNormal(position, sdf, params.normalOffset);
-        const LaneMask<T> accepted = candidate && IsAValidHit(ray, m.t, hitSurfaceNormal, extent);
-        // if (IsAValidHit(...)) { ...; return true; }
-        result.hit = result.hit || accepted;
-        result.thit = select(accepted, m.t, result.thit);
-        result.normal = select(accepted, hitSurfaceNormal, result.normal);
-        result.position = select(accepted, position, result.position);
-        running = running && !accepted;
+        if (candidates) {
+            *candidates = *candidates || candidate;
+            *candidateDistance = select(candidate, distance, *candidateDistance);
+            running = running && !candidate;
+        } else {
+            sphereTraceCandidate(ray, extent, sdf, params, candidate, position, m, running);
+        }
     }
     m.t = select(running, m.t + params.stepScale * distance, m.t);  // t += stepScale * distance
 }
@@ -345,49 +364,143 @@ struct SphereTraceRay {
 
 namespace detail {
 
-// One pass of RaySignedDistancePrimitiveTestQueue over the lanes of L for the rays of `marching` (bit k for ray k),
-// from and back to their state in `march`; returns the rays left for a narrower pass (marchQueueUntil's leaveAt).
-template <class L, class Sdf, class S = typename L::Scalar>
-uint32_t sphereTraceQueuePass(const SphereTraceRay<S>* rays, int count, uint32_t marching, Sdf& sdf,
-                              const SphereTraceParams<S>& params, SphereTraceMarch<S>* march, int leaveAt) {
+// A queued ray's state between passes: its march, and whether it left its last pass as a candidate hit with the
+// distance that made it one.
+template <typename S>
+struct SphereTraceQueued {
+    SphereTraceMarch<S> march;
+    bool candidate = false;
+    S distance = S(0);
+};
+
+// A queued ray's march state into lane j of (ray, extent, stepScale, m), and back.
+template <class L, class S = typename L::Scalar>
+struct SphereTraceLanes {
     Ray<L> ray;
     RayExtent<L> extent;
-    SphereTraceParams<L> laneParams;
-    laneParams.threshold = L(params.threshold);
-    laneParams.normalOffset = L(params.normalOffset);
+    SphereTraceParams<L> params;
     SphereTraceMarch<L> m;
+    L distance = L(S(0));
+
+    explicit SphereTraceLanes(const SphereTraceParams<S>& p) {
+        params.threshold = L(p.threshold);
+        params.normalOffset = L(p.normalOffset);
+    }
+    void load(int j, const SphereTraceRay<S>& r, const SphereTraceQueued<S>& from) {
+        setLane(ray, j, r.ray);
+        setLane(extent, j, r.extent);
+        setLane(params.stepScale, j, r.stepScale);
+        setLane(m.t, j, from.march.t);
+        setLane(m.result.hit, j, bool(from.march.result.hit));
+        setLane(m.result.thit, j, from.march.result.thit);
+        setLane(m.result.normal, j, from.march.result.normal);
+        setLane(m.result.position, j, from.march.result.position);
+        setLane(m.result.steps, j, from.march.result.steps);
+        setLane(distance, j, from.distance);
+    }
+    void store(int j, SphereTraceQueued<S>& to) const {
+        to.march.t = lane(m.t, j);
+        to.march.result.hit = lane(m.result.hit, j);
+        to.march.result.thit = lane(m.result.thit, j);
+        to.march.result.normal = lane(m.result.normal, j);
+        to.march.result.position = lane(m.result.position, j);
+        to.march.result.steps = lane(m.result.steps, j);
+        to.distance = lane(distance, j);
+    }
+};
+
+inline int sphereTraceStepLimit(std::uint32_t maxSteps) { return int(std::min<std::uint32_t>(maxSteps, 1u << 30)); }
+
+// One pass of RaySignedDistancePrimitiveTestQueue over the lanes of L for the rays of `marching` (bit k for ray k),
+// from and back to their state in `queued`: a ray marches until it stops, runs out of steps, or meets a candidate
+// hit (then it leaves with `candidate` set, for sphereTraceCandidatesPass). Returns the rays left for a narrower
+// pass (marchQueueUntil's leaveAt).
+template <class L, class Sdf, class S = typename L::Scalar>
+uint32_t sphereTraceQueuePass(const SphereTraceRay<S>* rays, int count, uint32_t marching, Sdf& sdf,
+                              const SphereTraceParams<S>& params, SphereTraceQueued<S>* queued, int leaveAt) {
+    SphereTraceLanes<L> lanes(params);
+    LaneMask<L> candidates(false);
     return marchQueueUntil<L>(
-        count, int(std::min<std::uint32_t>(params.maxSteps, std::uint32_t(1) << 30)),
-        [marching](int k) { return (marching >> k & 1u) != 0; },
+        count, sphereTraceStepLimit(params.maxSteps), [marching](int k) { return (marching >> k & 1u) != 0; },
         [&](int j, int k) {
-            const SphereTraceRay<S>& r = rays[k];
-            setLane(ray, j, r.ray);
-            setLane(extent, j, r.extent);
-            setLane(laneParams.stepScale, j, r.stepScale);
-            const SphereTraceMarch<S>& from = march[k];
-            setLane(m.t, j, from.t);
-            setLane(m.result.hit, j, bool(from.result.hit));
-            setLane(m.result.thit, j, from.result.thit);
-            setLane(m.result.normal, j, from.result.normal);
-            setLane(m.result.position, j, from.result.position);
-            setLane(m.result.steps, j, from.result.steps);
+            lanes.load(j, rays[k], queued[k]);
+            setLane(candidates, j, false);
         },
         [&](LaneMask<L>& running) {
             // A running lane has taken `steps` iterations, each of which counted itself: this one is steps + 1.
-            sphereTraceStep(ray, extent, sdf, laneParams, m.result.steps + LaneUint<L>(1u), m, running);
+            sphereTraceStep(lanes.ray, lanes.extent, sdf, lanes.params, lanes.m.result.steps + LaneUint<L>(1u),
+                            lanes.m, running, &candidates, &lanes.distance);
         },
         [&](int j, int k) {
-            SphereTraceMarch<S>& to = march[k];
-            to.t = lane(m.t, j);
-            to.result.hit = lane(m.result.hit, j);
-            to.result.thit = lane(m.result.thit, j);
-            to.result.normal = lane(m.result.normal, j);
-            to.result.position = lane(m.result.position, j);
-            to.result.steps = lane(m.result.steps, j);
+            lanes.store(j, queued[k]);
+            queued[k].candidate = lane(candidates, j);
         },
         leaveAt,
         // A ray that still marches counted each of its steps (result.steps is the iteration it is at).
-        [march](int k) { return int(march[k].result.steps); });
+        [queued](int k) { return int(queued[k].march.result.steps); });
+}
+
+// The candidate hits of `rays` (bit k for ray k, at most L's lanes of them) judged together over the lanes of L: the
+// rest of each one's loop iteration (sphereTraceCandidate, then t += stepScale * distance if rejected). Returns the
+// rejected rays with steps left, which march on.
+template <class L, class Sdf, class S = typename L::Scalar>
+uint32_t sphereTraceCandidatesPass(const SphereTraceRay<S>* rays, uint32_t candidates, Sdf& sdf,
+                                   const SphereTraceParams<S>& params, SphereTraceQueued<S>* queued) {
+    SphereTraceLanes<L> lanes(params);
+    std::array<int, size_t(L::kCount)> ray{};
+    int n = 0;
+    for (uint32_t c = candidates; c; c &= c - 1) ray[size_t(n++)] = std::countr_zero(c);
+    for (int j = 0; j < L::kCount; ++j) {  // the lanes past n hold the first candidate again (sane math, never kept)
+        const int k = ray[size_t(j < n ? j : 0)];
+        lanes.load(j, rays[k], queued[k]);
+    }
+    LaneMask<L> running(false);
+    for (int j = 0; j < n; ++j) setLane(running, j, true);
+    const LiveLanes live(running);
+    const LaneMask<L> candidate = running;
+    const vec3<L> position = lanes.ray.origin + lanes.m.t * lanes.ray.direction;  // the candidate's, recomputed
+    sphereTraceCandidate(lanes.ray, lanes.extent, sdf, lanes.params, candidate, position, lanes.m, running);
+    lanes.m.t = select(running, lanes.m.t + lanes.params.stepScale * lanes.distance, lanes.m.t);
+    uint32_t resume = 0;
+    const int limit = sphereTraceStepLimit(params.maxSteps);
+    for (int j = 0; j < n; ++j) {
+        SphereTraceQueued<S>& q = queued[ray[size_t(j)]];
+        lanes.store(j, q);
+        q.candidate = false;
+        if (lane(running, j) && int(q.march.result.steps) < limit) resume |= 1u << ray[size_t(j)];
+    }
+    return resume;
+}
+
+// March passes (over L, the last 8 or fewer rays over 8) and candidate passes (the candidates of a march pass
+// judged over L, or 8 lanes for 8 or fewer) until every ray of `marching` has ended.
+template <class L, class Sdf, class S = typename L::Scalar>
+void sphereTraceQueue(const SphereTraceRay<S>* rays, int count, uint32_t marching, Sdf& sdf,
+                      const SphereTraceParams<S>& params, SphereTraceQueued<S>* queued) {
+    constexpr int kNarrow = 8;
+    using Narrow = Lanes<S, kNarrow>;
+    while (marching) {
+        if constexpr (L::kCount > kNarrow) {
+            const uint32_t left = sphereTraceQueuePass<L>(rays, count, marching, sdf, params, queued, kNarrow);
+            if (left) sphereTraceQueuePass<Narrow>(rays, count, left, sdf, params, queued, 0);
+        } else {
+            sphereTraceQueuePass<L>(rays, count, marching, sdf, params, queued, 0);
+        }
+        uint32_t candidates = 0;
+        for (uint32_t r = marching; r; r &= r - 1)
+            if (queued[std::countr_zero(r)].candidate) candidates |= 1u << std::countr_zero(r);
+        marching = 0;
+        while (candidates) {
+            uint32_t batch = candidates;  // the first L::kCount candidates
+            for (int taken = 0, k = 0; k < 32; ++k)
+                if (batch >> k & 1u && ++taken > L::kCount) batch &= ~(1u << k);
+            candidates &= ~batch;
+            if (L::kCount > kNarrow && std::popcount(batch) <= kNarrow)
+                marching |= sphereTraceCandidatesPass<Narrow>(rays, batch, sdf, params, queued);
+            else
+                marching |= sphereTraceCandidatesPass<L>(rays, batch, sdf, params, queued);
+        }
+    }
 }
 
 }  // namespace detail
@@ -400,21 +513,18 @@ uint32_t sphereTraceQueuePass(const SphereTraceRay<S>* rays, int count, uint32_t
 // Over more than 8 lanes, the rays that still march once the queue is empty and 8 or fewer remain go on in 8 lanes
 // (Lanes<S, 8>): an 8-lane step costs less than a wide one (on AVX-512 a 16-float instruction is two 8-float
 // halves), and a resumed ray takes the steps it would have taken, from the state it stopped at.
+// A ray whose step meets a candidate hit leaves the march there, and the candidates of a pass are judged together
+// (the normal's four distance evaluations and IsAValidHit, over the lanes of as many rays as there are): judged in the
+// step, each candidate cost every lane of the step those four evaluations. A rejected candidate ends its step
+// (t += stepScale * distance) and marches on in the next pass.
 // PORT: not in the HLSL; a GPU runs a wave's sphere tracing in its lanes, each lane until its own ray ends.
 template <class L, class Sdf, class S = typename L::Scalar>
 void RaySignedDistancePrimitiveTestQueue(const SphereTraceRay<S>* rays, int count, Sdf&& sdf,
                                          const SphereTraceParams<S>& params, SphereTraceResult<S>* out) {
-    std::array<SphereTraceMarch<S>, kMaxMarchQueue> march{};
-    for (int k = 0; k < count; ++k) march[size_t(k)].t = rays[k].extent.tMin;  // where a ray that never steps stays
-    const uint32_t all = count >= 32 ? ~0u : (1u << count) - 1u;
-    constexpr int kNarrow = 8;
-    if constexpr (L::kCount > kNarrow) {
-        const uint32_t left = detail::sphereTraceQueuePass<L>(rays, count, all, sdf, params, march.data(), kNarrow);
-        if (left) detail::sphereTraceQueuePass<Lanes<S, kNarrow>>(rays, count, left, sdf, params, march.data(), 0);
-    } else {
-        detail::sphereTraceQueuePass<L>(rays, count, all, sdf, params, march.data(), 0);
-    }
-    for (int k = 0; k < count; ++k) out[k] = march[size_t(k)].result;
+    std::array<detail::SphereTraceQueued<S>, kMaxMarchQueue> queued{};
+    for (int k = 0; k < count; ++k) queued[size_t(k)].march.t = rays[k].extent.tMin;  // where a ray that never steps stays
+    detail::sphereTraceQueue<L>(rays, count, count >= 32 ? ~0u : (1u << count) - 1u, sdf, params, queued.data());
+    for (int k = 0; k < count; ++k) out[k] = queued[size_t(k)].march.result;
 }
 
 }  // namespace refray::procedural::math
