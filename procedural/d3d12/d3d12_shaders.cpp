@@ -368,6 +368,11 @@ PrimitiveHit<T> IntersectPrimitive(IntersectionShader shader, uint32_t primitive
     return {};
 }
 
+// The float lanes of the latency-bound marches below (the sphere-tracing queue, and inline tracing's procedural
+// calls of more than kWaveLanes lanes, which take up to this many a call).
+inline constexpr int kWideLanes = 16;
+using WideLanes = math::Lanes<float, kWideLanes>;
+
 // The SignedDistancePrimitive test (RaySignedDistancePrimitiveTest) for up to kMaxWaveWidth rays of one primitive
 // type over 16 float lanes, refilled as rays stop, the last 8 or fewer rays over 8 (math::
 // RaySignedDistancePrimitiveTestQueue): out[k] is bit for bit IntersectPrimitive<float>'s hit for ray k. What a
@@ -377,7 +382,7 @@ PrimitiveHit<T> IntersectPrimitive(IntersectionShader shader, uint32_t primitive
 // a queue of 26 rays a call on average (the D3D12 view) keeps 16 lanes busy until its last 8 rays.
 void SignedDistanceQueue(uint32_t primitiveType, const Accuracy& accuracy, const math::SphereTraceRay<float>* rays,
                          int count, PrimitiveHit<float>* out) {
-    using L = math::Lanes<float, 16>;
+    using L = WideLanes;
     [[maybe_unused]] PrecisionScope<L> scope;
     // Over 16 lanes, and over 8 for the queue's tail.
     const auto sdf = [primitiveType](const auto& position) {
@@ -443,10 +448,10 @@ void runPrimitiveCalls(std::span<void* const> lanes) {
         return;
     }
     if (lanes.size() <= size_t(kWaveLanes)) return runPrimitiveCallsIn<WaveLanes<float>>(lanes);
-    runPrimitiveCallsIn<math::Lanes<float, 16>>(lanes);
+    runPrimitiveCallsIn<WideLanes>(lanes);
 }
 
-inline constexpr dxr::WaveFunction kPrimitiveCalls{runPrimitiveCalls, 16};
+inline constexpr dxr::WaveFunction kPrimitiveCalls{runPrimitiveCalls, kWideLanes};
 
 // The SignedDistancePrimitive calls of a wave: a whole wave's lanes a call, through SignedDistanceQueue (one lane
 // alone in float, as runPrimitiveCalls).
