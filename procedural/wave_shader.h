@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <new>
 #include <optional>
 #include <type_traits>
@@ -76,12 +77,14 @@ auto gatherLanes(dxr::IntersectionWave& wave, F f) {
     return values;
 }
 
-// The lanes of one value of every lane's input: lane i of the result is get(in[i]) (for a group of one lane, whose
-// lane type is the scalar type itself, the value of its input, which every entry holds; gatherLanes).
-template <class Result, class Input, class Get>
+// The lanes of one value of every lane's input: lane i of the result is get(in[i]), for the Count lanes of its lane
+// type (for a group of one lane, whose lane type is the scalar type itself, the value of its input, which every
+// entry holds; gatherLanes).
+template <class Result, int Count = kWaveLanes, class Input, class Get>
 Result toLanes(const std::array<Input, dxr::kMaxWaveWidth>& in, Get get) {
+    static_assert(Count >= 1 && Count <= dxr::kMaxWaveWidth);
     Result lanes{};
-    for (int i = 0; i < kWaveLanes; ++i) math::setLane(lanes, i, get(in[size_t(i)]));
+    for (int i = 0; i < Count; ++i) math::setLane(lanes, i, get(in[size_t(i)]));
     return lanes;
 }
 
@@ -127,19 +130,28 @@ void inGroupsOfLanes(dxr::LaneMask lanes, Group&& group, Alone&& alone) {
 }
 
 // Calls f.template operator()<L>() with the lane type a record group's math runs in: T itself for a group of one lane
-// (nothing to keep in step, and no lanes to pay for), WaveLanes<T> otherwise. A scalar type without SIMD
+// (nothing to keep in step, and no lanes to pay for), WaveLanes<T> for up to kWaveLanes lanes, and Lanes<T, Wide>
+// for more (an export that takes Wide lanes a call: a latency-bound march, whose 16 float lanes are two independent
+// 8-float chains). A scalar type without SIMD
 // instructions (PerturbedFloat, whose every operation is a hash and a rounding) runs each lane alone in T, and so does
 // double: its lanes are twice as wide as the 32-bit lane masks, so every compare and select goes lane by lane, and
 // a double Julia render at 320x180 took 26.5 s in lanes against 1.05 s one lane at a time. All give each lane the
 // same bits.
-template <typename T, class F>
+template <typename T, int Wide = kWaveLanes, class F>
 void withLaneType(dxr::IntersectionWave& wave, F&& f) {
-    if constexpr (!std::is_same_v<T, float>)
+    static_assert(Wide >= kWaveLanes && Wide <= dxr::kMaxWaveWidth);
+    if constexpr (!std::is_same_v<T, float>) {
         wave.forEachLaneAlone([&] { f.template operator()<T>(); });
-    else if (wave.active().count() == 1)
-        f.template operator()<T>();
-    else
-        f.template operator()<WaveLanes<T>>();
+    } else {
+        // The lanes of a call are numbered from 0; the lane type must reach the highest active one.
+        const int span = std::bit_width(wave.active().bits());
+        if (wave.active().count() == 1) f.template operator()<T>();
+        else if (Wide == kWaveLanes || span <= kWaveLanes) f.template operator()<WaveLanes<T>>();
+        else if constexpr (Wide > kWaveLanes) {
+            REFRAY_ASSERT(span <= Wide, "a record group call reaching lane " << span - 1 << " of " << Wide << " lanes");
+            f.template operator()<math::Lanes<T, Wide>>();
+        }
+    }
 }
 
 }  // namespace refray::procedural

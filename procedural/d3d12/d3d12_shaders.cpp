@@ -1234,9 +1234,9 @@ void InlineAmbientOcclusionCS(ComputeWave& wave, const TraceRayArgumentSet& trac
 // The three intersection shaders (MyIntersectionShader_AnalyticPrimitive, _VolumetricPrimitive,
 // _SignedDistancePrimitive), run once over the lanes of a record group (emulator/intersection_wave.h).
 // PORT: each lane reads its own ray, record and constants, and reports its own hit, with the one-ray code in T; the
-// intersection test between them runs over the lanes at once (T's lanes, WaveLanes<T>; T itself for a group of one
-// lane, withLaneType). The lanes of a record group
-// share the record, so the primitive type is the group's.
+// intersection test between them runs over the lanes at once (T's lanes: WaveLanes<T>, 16 float lanes for a group of
+// more than 8, T itself for a group of one lane; withLaneType). The lanes of a record group share the record, so the
+// primitive type is the group's.
 template <typename T, typename L>
 void IntersectionShaderOf(IntersectionWave& wave, IntersectionShader shader, const Accuracy& accuracy) {
     [[maybe_unused]] PrecisionScope<L> scope;
@@ -1279,8 +1279,9 @@ void IntersectionShaderOf(IntersectionWave& wave, IntersectionShader shader, con
                     });
         }
         const math::LiveLanes live(wave.active().bits(), 0);  // duplicated inactive lanes skip libm's calls
-        const auto localRay = toLanes<math::Ray<L>>(in, [](const LaneInput& l) { return l.localRay; });
-        const auto extent = toLanes<math::RayExtent<L>>(in, [](const LaneInput& l) { return l.extent; });
+        constexpr int kLanes = math::kLaneCount<L>;
+        const auto localRay = toLanes<math::Ray<L>, kLanes>(in, [](const LaneInput& l) { return l.localRay; });
+        const auto extent = toLanes<math::RayExtent<L>, kLanes>(in, [](const LaneInput& l) { return l.extent; });
         const L elapsedTime(group.elapsedTime);
         const L stepScale(group.stepScale);
         const PrimitiveHit<L> test =
@@ -1347,17 +1348,19 @@ void addExports(ShaderLibrary& lib, const TraceRayArgumentSet& traceRay, const A
     lib.addMiss<RayPayload>("MyMissShader", MyMissShader);
     lib.addMiss<ShadowRayPayload>("MyMissShader_ShadowRay", MyMissShader_ShadowRay);
     // Each intersection shader's ReportHit is its last action, as in the HLSL: ReportHitEnd::Return spares the unwind
-    // when a shadow ray's hit ends the search (docs/emulator.md, "Ending an intersection shader").
-    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("MyIntersectionShader_AnalyticPrimitive", kWaveLanes,
+    // when a shadow ray's hit ends the search (docs/emulator.md, "Ending an intersection shader"). The analytic and
+    // volumetric ones take up to 16 lanes a call, over 16 float lanes beyond 8 (the metaballs' latency-bound march,
+    // as inline tracing's kPrimitiveCalls).
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("MyIntersectionShader_AnalyticPrimitive", kWideLanes,
         in([accuracy](IntersectionWave& wave) {
-            withLaneType<T>(wave, [&]<class L>() {
+            withLaneType<T, kWideLanes>(wave, [&]<class L>() {
                 IntersectionShaderOf<T, L>(wave, IntersectionShader::AnalyticPrimitive, accuracy);
             });
         }),
         ReportHitEnd::Return);
-    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("MyIntersectionShader_VolumetricPrimitive", kWaveLanes,
+    lib.addWaveIntersection<ProceduralPrimitiveAttributes>("MyIntersectionShader_VolumetricPrimitive", kWideLanes,
         in([accuracy](IntersectionWave& wave) {
-            withLaneType<T>(wave, [&]<class L>() {
+            withLaneType<T, kWideLanes>(wave, [&]<class L>() {
                 IntersectionShaderOf<T, L>(wave, IntersectionShader::VolumetricPrimitive, accuracy);
             });
         }),

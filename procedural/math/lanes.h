@@ -220,6 +220,11 @@ template <class S, int N>
 struct IsLanes<Lanes<S, N>> : std::true_type {};
 template <class T>
 inline constexpr bool kIsLanes = IsLanes<T>::value;
+// How many rays a value of T holds: N for Lanes<S, N>, 1 for a scalar.
+template <class T>
+inline constexpr int kLaneCount = 1;
+template <class S, int N>
+inline constexpr int kLaneCount<Lanes<S, N>> = N;
 
 // ---- The lane-mask helpers (written once for scalars and lanes) -------------------------------------------------
 namespace detail {
