@@ -374,8 +374,9 @@ inline constexpr int kWideLanes = 16;
 using WideLanes = math::Lanes<float, kWideLanes>;
 
 // The SignedDistancePrimitive test (RaySignedDistancePrimitiveTest) for up to kMaxWaveWidth rays of one primitive
-// type over 16 float lanes, refilled as rays stop, the last 8 or fewer rays over 8 (math::
-// RaySignedDistancePrimitiveTestQueue): out[k] is bit for bit IntersectPrimitive<float>'s hit for ray k. What a
+// type over 16 float lanes (two sets of them, stepped one after the other, while more than 16 rays march), refilled
+// as rays stop, the last 8 or fewer rays over 8 (math::RaySignedDistancePrimitiveTestQueue): out[k] is bit for bit
+// IntersectPrimitive<float>'s hit for ray k. What a
 // record group of the intersection shader, and a wave call of inline ray tracing, run for their lanes.
 // PORT: 16 lanes, not WaveLanes' 8: the sphere tracing is one chain of dependent instructions a step (the fractal
 // pyramid's iterations above all), and a 16-float step is two independent 8-float chains that the core overlaps;

@@ -21,13 +21,24 @@ inline constexpr int kMaxMarchQueue = 32;
 // lanes still march, it stores their rays' state (store) and returns the rays that have not stopped, bit k for ray
 // k (0 when every ray ran to its end). taken(k) is how many steps ray k took before (a resumed march): it has
 // maxSteps - taken(k) left.
-template <class L, class Marches, class Load, class Step, class Store, class Taken>
+// Groups > 1 marches Groups independent sets of L's lanes at each step (lane j is lane j % L::kCount of set
+// j / L::kCount): step gets the sets' masks (std::array<LaneMask<L>, Groups>&) and runs them one after the other, so
+// that the core overlaps their chains of dependent instructions (a latency-bound march over 16-float lanes, two
+// 8-float halves, has room for more).
+template <class L, int Groups = 1, class Marches, class Load, class Step, class Store, class Taken>
 uint32_t marchQueueUntil(int count, int maxSteps, Marches&& marches, Load&& load, Step&& step, Store&& store,
                          int leaveAt, Taken&& taken) {
-    constexpr int N = L::kCount;
+    constexpr int NL = L::kCount;
+    constexpr int N = NL * Groups;
     static_assert(N <= 32, "a march queue's lanes are bits of a 32-bit mask");
     if (maxSteps <= 0) return 0;
-    LaneMask<L> running(false);
+    std::array<LaneMask<L>, size_t(Groups)> running;
+    running.fill(LaneMask<L>(false));
+    const auto runningBits = [&running] {
+        uint32_t bits = 0;
+        for (int g = 0; g < Groups; ++g) bits |= laneBits(running[size_t(g)]) << (g * NL);
+        return bits;
+    };
     std::array<int, size_t(N)> ray{};  // the ray each lane marches
     // A lane's ray has taken its last step once the queue's step count reaches the lane's deadline: the count when
     // the ray came in, plus the steps it has left (every running lane steps at every step of the queue).
@@ -38,23 +49,23 @@ uint32_t marchQueueUntil(int count, int maxSteps, Marches&& marches, Load&& load
     const auto fill = [&](int j) {
         while (next < count && !marches(next)) ++next;
         if (next == count) {
-            setLane(running, j, false);
+            setLane(running[size_t(j / NL)], j % NL, false);
             return;
         }
         ray[size_t(j)] = next;
         deadline[size_t(j)] = stepsTaken + maxSteps - taken(next);
         nearestDeadline = std::min(nearestDeadline, deadline[size_t(j)]);
         load(j, next++);
-        setLane(running, j, true);
+        setLane(running[size_t(j / NL)], j % NL, true);
     };
     for (int j = 0; j < N; ++j) fill(j);
-    const int first = std::countr_zero(laneBits(running));  // 32 when no ray marches
+    const int first = std::countr_zero(runningBits());  // 32 when no ray marches
     if (first >= N) return 0;
     for (int j = 0; j < N; ++j)
-        if (!lane(running, j)) load(j, ray[size_t(first)]);
+        if (!(runningBits() >> j & 1u)) load(j, ray[size_t(first)]);
     const LiveLanes queueLanes(laneBits(LaneMask<L>(true)), 0);  // the queue's lanes, whatever encloses it
     // Per step, the lanes whose ray stopped come from the masks (a few instructions), not from a pass over the lanes.
-    for (uint32_t stepped = laneBits(running); stepped; stepped = laneBits(running)) {
+    for (uint32_t stepped = runningBits(); stepped; stepped = runningBits()) {
         if (next == count && std::popcount(stepped) <= leaveAt) {  // a narrower march takes the rest
             uint32_t left = 0;
             for (uint32_t live = stepped; live; live &= live - 1) {
@@ -64,9 +75,10 @@ uint32_t marchQueueUntil(int count, int maxSteps, Marches&& marches, Load&& load
             }
             return left;
         }
-        step(running);
+        if constexpr (Groups == 1) step(running[0]);
+        else step(running);
         ++stepsTaken;
-        uint32_t stopped = stepped & ~laneBits(running);
+        uint32_t stopped = stepped & ~runningBits();
         if (stepsTaken >= nearestDeadline) {  // some running ray may have taken its last step
             nearestDeadline = stepsTaken + maxSteps;
             for (uint32_t live = stepped & ~stopped; live; live &= live - 1) {
@@ -93,7 +105,7 @@ uint32_t marchQueueUntil(int count, int maxSteps, Marches&& marches, Load&& load
 // never run and are never stored.
 template <class L, class Marches, class Load, class Step, class Store>
 void marchQueue(int count, int maxSteps, Marches&& marches, Load&& load, Step&& step, Store&& store) {
-    marchQueueUntil<L>(count, maxSteps, marches, load, step, store, 0, [](int) { return 0; });
+    marchQueueUntil<L, 1>(count, maxSteps, marches, load, step, store, 0, [](int) { return 0; });
 }
 
 }  // namespace refray::procedural::math

@@ -382,6 +382,7 @@ struct SphereTraceLanes {
     SphereTraceMarch<L> m;
     L distance = L(S(0));
 
+    SphereTraceLanes() = default;
     explicit SphereTraceLanes(const SphereTraceParams<S>& p) {
         params.threshold = L(p.threshold);
         params.normalOffset = L(p.normalOffset);
@@ -411,29 +412,37 @@ struct SphereTraceLanes {
 
 inline int sphereTraceStepLimit(std::uint32_t maxSteps) { return int(std::min<std::uint32_t>(maxSteps, 1u << 30)); }
 
-// One pass of RaySignedDistancePrimitiveTestQueue over the lanes of L for the rays of `marching` (bit k for ray k),
-// from and back to their state in `queued`: a ray marches until it stops, runs out of steps, or meets a candidate
-// hit (then it leaves with `candidate` set, for sphereTraceCandidatesPass). Returns the rays left for a narrower
-// pass (marchQueueUntil's leaveAt).
-template <class L, class Sdf, class S = typename L::Scalar>
+// One pass of RaySignedDistancePrimitiveTestQueue over the lanes of L (Groups sets of them, marchQueueUntil) for the
+// rays of `marching` (bit k for ray k), from and back to their state in `queued`: a ray marches until it stops, runs
+// out of steps, or meets a candidate hit (then it leaves with `candidate` set, for sphereTraceCandidatesPass).
+// Returns the rays left for a narrower pass (marchQueueUntil's leaveAt).
+template <class L, int Groups = 1, class Sdf, class S = typename L::Scalar>
 uint32_t sphereTraceQueuePass(const SphereTraceRay<S>* rays, int count, uint32_t marching, Sdf& sdf,
                               const SphereTraceParams<S>& params, SphereTraceQueued<S>* queued, int leaveAt) {
-    SphereTraceLanes<L> lanes(params);
-    LaneMask<L> candidates(false);
-    return marchQueueUntil<L>(
+    constexpr int NL = L::kCount;
+    std::array<SphereTraceLanes<L>, size_t(Groups)> lanes;
+    lanes.fill(SphereTraceLanes<L>(params));
+    std::array<LaneMask<L>, size_t(Groups)> candidates;
+    candidates.fill(LaneMask<L>(false));
+    // A running lane has taken `steps` iterations, each of which counted itself: this one is steps + 1.
+    const auto stepGroup = [&](int g, LaneMask<L>& running) {
+        SphereTraceLanes<L>& l = lanes[size_t(g)];
+        sphereTraceStep(l.ray, l.extent, sdf, l.params, l.m.result.steps + LaneUint<L>(1u), l.m, running,
+                        &candidates[size_t(g)], &l.distance);
+    };
+    return marchQueueUntil<L, Groups>(
         count, sphereTraceStepLimit(params.maxSteps), [marching](int k) { return (marching >> k & 1u) != 0; },
         [&](int j, int k) {
-            lanes.load(j, rays[k], queued[k]);
-            setLane(candidates, j, false);
+            lanes[size_t(j / NL)].load(j % NL, rays[k], queued[k]);
+            setLane(candidates[size_t(j / NL)], j % NL, false);
         },
-        [&](LaneMask<L>& running) {
-            // A running lane has taken `steps` iterations, each of which counted itself: this one is steps + 1.
-            sphereTraceStep(lanes.ray, lanes.extent, sdf, lanes.params, lanes.m.result.steps + LaneUint<L>(1u),
-                            lanes.m, running, &candidates, &lanes.distance);
+        [&](auto& running) {
+            if constexpr (Groups == 1) stepGroup(0, running);
+            else for (int g = 0; g < Groups; ++g) stepGroup(g, running[size_t(g)]);
         },
         [&](int j, int k) {
-            lanes.store(j, queued[k]);
-            queued[k].candidate = lane(candidates, j);
+            lanes[size_t(j / NL)].store(j % NL, queued[k]);
+            queued[k].candidate = lane(candidates[size_t(j / NL)], j % NL);
         },
         leaveAt,
         // A ray that still marches counted each of its steps (result.steps is the iteration it is at).
@@ -472,8 +481,9 @@ uint32_t sphereTraceCandidatesPass(const SphereTraceRay<S>* rays, uint32_t candi
     return resume;
 }
 
-// March passes (over L, the last 8 or fewer rays over 8) and candidate passes (the candidates of a march pass
-// judged over L, or 8 lanes for 8 or fewer) until every ray of `marching` has ended.
+// March passes (over two sets of L's lanes while more rays march than L holds, over L otherwise; the last 8 or fewer
+// rays over 8) and candidate passes (the candidates of a march pass judged over L, or 8 lanes for 8 or fewer) until
+// every ray of `marching` has ended.
 template <class L, class Sdf, class S = typename L::Scalar>
 void sphereTraceQueue(const SphereTraceRay<S>* rays, int count, uint32_t marching, Sdf& sdf,
                       const SphereTraceParams<S>& params, SphereTraceQueued<S>* queued) {
@@ -481,7 +491,11 @@ void sphereTraceQueue(const SphereTraceRay<S>* rays, int count, uint32_t marchin
     using Narrow = Lanes<S, kNarrow>;
     while (marching) {
         if constexpr (L::kCount > kNarrow) {
-            const uint32_t left = sphereTraceQueuePass<L>(rays, count, marching, sdf, params, queued, kNarrow);
+            uint32_t left = marching;
+            if (std::popcount(marching) > L::kCount)
+                left = sphereTraceQueuePass<L, 2>(rays, count, marching, sdf, params, queued, kNarrow);
+            else
+                left = sphereTraceQueuePass<L>(rays, count, left, sdf, params, queued, kNarrow);
             if (left) sphereTraceQueuePass<Narrow>(rays, count, left, sdf, params, queued, 0);
         } else {
             sphereTraceQueuePass<L>(rays, count, marching, sdf, params, queued, 0);
@@ -510,9 +524,11 @@ void sphereTraceQueue(const SphereTraceRay<S>* rays, int count, uint32_t marchin
 // RaySignedDistancePrimitiveTest(rays[k].ray, rays[k].extent, sdf, params with rays[k].stepScale) in S. `sdf` runs
 // over the lanes (a generic callable: over L, and over Lanes<S, 8> for the tail below); params' threshold, maxSteps
 // and normalOffset are every ray's (its stepScale is not read).
-// Over more than 8 lanes, the rays that still march once the queue is empty and 8 or fewer remain go on in 8 lanes
-// (Lanes<S, 8>): an 8-lane step costs less than a wide one (on AVX-512 a 16-float instruction is two 8-float
-// halves), and a resumed ray takes the steps it would have taken, from the state it stopped at.
+// Over more than 8 lanes, a queue of more rays than L holds marches two sets of L's lanes at each step, one after
+// the other (marchQueueUntil's Groups: the core overlaps their independent chains of dependent instructions), and
+// the rays that still march once the queue is empty and 8 or fewer remain go on in 8 lanes (Lanes<S, 8>): an
+// 8-lane step costs less than a wide one (on AVX-512 a 16-float instruction is two 8-float halves), and a resumed
+// ray takes the steps it would have taken, from the state it stopped at.
 // A ray whose step meets a candidate hit leaves the march there, and the candidates of a pass are judged together
 // (the normal's four distance evaluations and IsAValidHit, over the lanes of as many rays as there are): judged in the
 // step, each candidate cost every lane of the step those four evaluations. A rejected candidate ends its step

@@ -250,8 +250,9 @@ TEST(LanesSdf, SphereTracingMatchesScalarPerLane) {
 }
 
 TEST(LanesSdf, SphereTracingQueuesGiveEachRayItsScalarResult) {
-    // RaySignedDistancePrimitiveTestQueue refills its W lanes from a queue of up to 32 rays (over 16 lanes, its last 8
-    // or fewer rays go on over 8, from where they stopped): every ray's result (hit, t, normal, position, step count)
+    // RaySignedDistancePrimitiveTestQueue refills its W lanes from a queue of up to 32 rays (over 16 lanes, a queue of
+    // more than 16 marches two sets of 16, and its last 8 or fewer rays go on over 8, from where they stopped): every
+    // ray's result (hit, t, normal, position, step count)
     // is bit for bit its one-ray RaySignedDistancePrimitiveTest, for every queue length 1..32, with each ray's own stepScale, rays that hit, miss, start beyond RayTCurrent, run out of steps
     // (the coarse and one-step accuracies), and rays of NaN and infinite values.
     std::vector<RayIn> rays = makeRays(0x9E5, 16 * 10, 0.5f, 1.0f);
