@@ -491,11 +491,10 @@ void sphereTraceQueue(const SphereTraceRay<S>* rays, int count, uint32_t marchin
     using Narrow = Lanes<S, kNarrow>;
     while (marching) {
         if constexpr (L::kCount > kNarrow) {
-            uint32_t left = marching;
-            if (std::popcount(marching) > L::kCount)
-                left = sphereTraceQueuePass<L, 2>(rays, count, marching, sdf, params, queued, kNarrow);
-            else
-                left = sphereTraceQueuePass<L>(rays, count, left, sdf, params, queued, kNarrow);
+            const uint32_t left =
+                std::popcount(marching) > L::kCount
+                    ? sphereTraceQueuePass<L, 2>(rays, count, marching, sdf, params, queued, kNarrow)
+                    : sphereTraceQueuePass<L>(rays, count, marching, sdf, params, queued, kNarrow);
             if (left) sphereTraceQueuePass<Narrow>(rays, count, left, sdf, params, queued, 0);
         } else {
             sphereTraceQueuePass<L>(rays, count, marching, sdf, params, queued, 0);
