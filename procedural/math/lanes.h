@@ -53,12 +53,44 @@ template <class S>
 using LaneCompareInt = std::conditional_t<sizeof(S) == 8, int64_t, std::conditional_t<sizeof(S) == 4, int32_t,
                                           std::conditional_t<sizeof(S) == 2, int16_t, int8_t>>>;
 
-// m ? a : b over 32-bit lanes held in GCC vectors, where each lane of m has all its bits set or clear: for 8 lanes
-// one blend by m's sign bits (vblendvps), else a select on m != 0.
+// Whether LaneBools<N> keeps its lanes as the bits of an AVX-512 mask register (bit i: lane i), for 16 and 8 lanes
+// where AVX-512 (with VL, for 8) is there: a comparison of float lanes writes a mask register and a select blends by
+// it. Kept as a vector of all-ones lanes instead, each select cost two more instructions on its chain (the mask moved
+// into a vector by the comparison and tested back by the blend: GCC does not fold the round trip), a third of the
+// fractal pyramid's time.
+template <int N>
+inline constexpr bool kMaskRegisterBools =
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+    N == 16 || N == 8;
+#else
+    false;
+#endif
+
+// The storage of LaneBools<N>: a mask register's integer (kMaskRegisterBools), else a GCC vector of 32-bit lanes.
+template <int N, bool kMaskRegister = kMaskRegisterBools<N>>
+struct LaneBoolsStorage {
+    using type = typename LaneStorage<uint32_t, N>::type;
+};
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+template <int N>
+struct LaneBoolsStorage<N, true> {
+    using type = std::conditional_t<N == 16, __mmask16, __mmask8>;
+};
+#endif
+
+// m ? a : b over 32-bit lanes held in GCC vectors: for a mask register's m one blend by its bits; for a vector m, where
+// each lane has all its bits set or clear, for 8 lanes one blend by m's sign bits (vblendvps), else a select on m != 0.
 template <class Mask, class V>
 [[gnu::always_inline]] inline V selectLanes(const Mask& m, const V& a, const V& b) {
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+    if constexpr (std::is_integral_v<Mask> && sizeof(V) == 64) {
+        return V(_mm512_mask_blend_ps(m, __m512(b), __m512(a)));
+    } else if constexpr (std::is_integral_v<Mask> && sizeof(V) == 32) {
+        return V(_mm256_mask_blend_ps(m, __m256(b), __m256(a)));
+    }
+#endif
 #if defined(__AVX__)
-    if constexpr (sizeof(V) == 32) {
+    if constexpr (!std::is_integral_v<Mask> && sizeof(V) == 32) {
         __m256 x, y, c;
         std::memcpy(&x, &a, sizeof(x));
         std::memcpy(&y, &b, sizeof(y));
@@ -69,21 +101,76 @@ template <class Mask, class V>
         return out;
     }
 #endif
-    return m != 0u ? a : b;
+    if constexpr (!std::is_integral_v<Mask>) return m != 0u ? a : b;
+    else return a;  // unreachable: an integer mask exists only with AVX-512
+}
+
+// The comparison `a op b` of N 32-bit lanes of S (GCC vectors) into a mask register, with the predicate GCC gives the
+// operator for floats (the same signalling of NaNs, so the same exception flags) and the signed or unsigned integer
+// comparison for integers.
+template <class S, int N, int kFloatPredicate, int kIntPredicate, class V>
+[[gnu::always_inline]] inline auto compareToMask(const V& a, const V& b) {
+#if defined(__AVX512F__) && defined(__AVX512VL__)
+    static_assert(sizeof(S) == 4 && (N == 16 || N == 8));
+    if constexpr (N == 16) {
+        if constexpr (std::is_floating_point_v<S>) return _mm512_cmp_ps_mask(__m512(a), __m512(b), kFloatPredicate);
+        else if constexpr (std::is_signed_v<S>) return _mm512_cmp_epi32_mask(__m512i(a), __m512i(b), kIntPredicate);
+        else return _mm512_cmp_epu32_mask(__m512i(a), __m512i(b), kIntPredicate);
+    } else {
+        if constexpr (std::is_floating_point_v<S>) return _mm256_cmp_ps_mask(__m256(a), __m256(b), kFloatPredicate);
+        else if constexpr (std::is_signed_v<S>) return _mm256_cmp_epi32_mask(__m256i(a), __m256i(b), kIntPredicate);
+        else return _mm256_cmp_epu32_mask(__m256i(a), __m256i(b), kIntPredicate);
+    }
+#else
+    static_assert(sizeof(V) == 0, "mask-register comparisons need AVX-512");
+#endif
+}
+
+// Bit i set where lane i of the vector m (all bits set or clear per 32-bit lane) is: one instruction for 16 and 8
+// lanes, a horizontal OR otherwise.
+template <int N, class V>
+[[gnu::always_inline]] inline uint32_t vectorLaneBits(const V& m) {
+#if defined(__AVX512F__)
+    if constexpr (N == 16) {
+        __m512i x;
+        std::memcpy(&x, &m, sizeof(x));
+        return _mm512_test_epi32_mask(x, x);
+    }
+#endif
+#if defined(__AVX2__)
+    if constexpr (N == 8) {
+        __m256i x;
+        std::memcpy(&x, &m, sizeof(x));
+        return uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(x)));
+    }
+#endif
+    uint32_t bits = 0;
+    for (int i = 0; i < N; ++i) bits |= (m[i] != 0u ? 1u : 0u) << i;
+    return bits;
 }
 }  // namespace detail
 
 template <int N>
 struct LaneBools {
-    // All 32 bits set or clear per lane, as wide as a float lane: what a vector comparison of float lanes gives, so
-    // that a comparison is one instruction, and a select on it one blend by the lanes' sign bits (selectLanes).
-    using Storage = typename detail::LaneStorage<uint32_t, N>::type;
+    // The lanes' bits in a mask register where AVX-512 has one for N float lanes (detail::kMaskRegisterBools), else
+    // all 32 bits set or clear per lane, as wide as a float lane (what a vector comparison of float lanes gives): either
+    // way a comparison is one instruction and a select on it one blend (selectLanes).
+    static constexpr bool kMaskRegister = detail::kMaskRegisterBools<N>;
+    using Storage = typename detail::LaneBoolsStorage<N>::type;
     Storage v;
-    static constexpr uint32_t kSet = ~0u;
+    static constexpr uint32_t kSet = ~0u;  // a set lane of a vector Storage
 
     LaneBools() = default;
-    constexpr explicit LaneBools(bool b) : v(Storage{} + (b ? kSet : 0u)) {}
-    constexpr bool operator[](int i) const { return v[i] != 0; }
+    constexpr explicit LaneBools(bool b) : v(filled(b)) {}
+    constexpr bool operator[](int i) const {
+        if constexpr (kMaskRegister) return (uint32_t(v) >> i & 1u) != 0;
+        else return v[i] != 0;
+    }
+    // Lane i set to `value`.
+    constexpr void set(int i, bool value) {
+        if constexpr (kMaskRegister) v = Storage((uint32_t(v) & ~(1u << i)) | (uint32_t(value) << i));
+        else v[i] = value ? kSet : 0u;
+    }
 
     friend constexpr LaneBools operator&(LaneBools a, LaneBools b) {
         a.v &= b.v;
@@ -94,7 +181,7 @@ struct LaneBools {
         return a;
     }
     friend constexpr LaneBools operator!(LaneBools a) {
-        a.v = ~a.v;
+        a.v = Storage(~a.v);  // a mask register's integer is N bits wide: no bit above lane N - 1
         return a;
     }
     // && and || on masks are the lane-wise & and | (both sides are evaluated, as in a shader's SIMD code).
@@ -102,29 +189,20 @@ struct LaneBools {
     friend constexpr LaneBools operator||(LaneBools a, LaneBools b) { return a | b; }
     LaneBools& operator&=(LaneBools b) { return *this = *this & b; }
     LaneBools& operator|=(LaneBools b) { return *this = *this | b; }
+
+private:
+    static constexpr Storage filled(bool b) {
+        if constexpr (kMaskRegister) return Storage(b ? kLaneBits<N> : 0u);
+        else return Storage{} + (b ? kSet : 0u);
+    }
 };
 
 // Bit i set where lane i of m is: one mask instruction for the vector widths (a horizontal OR of N lanes otherwise),
 // which anyLane, allLanes and LiveLanes run at every step of a march.
 template <int N>
 [[gnu::always_inline]] inline uint32_t laneBits(const LaneBools<N>& m) {
-#if defined(__AVX512F__)
-    if constexpr (N == 16) {
-        __m512i x;
-        std::memcpy(&x, &m.v, sizeof(x));
-        return _mm512_test_epi32_mask(x, x);
-    }
-#endif
-#if defined(__AVX2__)
-    if constexpr (N == 8) {
-        __m256i x;
-        std::memcpy(&x, &m.v, sizeof(x));
-        return uint32_t(_mm256_movemask_ps(_mm256_castsi256_ps(x)));
-    }
-#endif
-    uint32_t bits = 0;
-    for (int i = 0; i < N; ++i) bits |= (m.v[i] != 0u ? 1u : 0u) << i;
-    return bits;
+    if constexpr (LaneBools<N>::kMaskRegister) return uint32_t(m.v);
+    else return detail::vectorLaneBits<N>(m.v);
 }
 
 template <class S, int N = kMaxLanes>
@@ -194,23 +272,27 @@ struct Lanes {
     }
     friend Lanes operator+(const Lanes& a) { return a; }
 
-#define REFRAY_LANES_COMPARE(op)                                                                     \
+#define REFRAY_LANES_COMPARE(op, floatPredicate, intPredicate)                                      \
     [[gnu::always_inline]] friend LaneBools<N> operator op(const Lanes& a, const Lanes& b) {         \
         LaneBools<N> r;                                                                              \
-        if constexpr (kVector && sizeof(S) == 4) {                                                   \
+        if constexpr (kVector && sizeof(S) == 4 && LaneBools<N>::kMaskRegister) {                    \
+            r.v = detail::compareToMask<S, N, floatPredicate, intPredicate>(a.v, b.v);               \
+        } else if constexpr (kVector && sizeof(S) == 4) {                                            \
             r.v = typename LaneBools<N>::Storage(a.v op b.v);                                        \
         } else {                                                                                     \
             r = LaneBools<N>(false);                                                                 \
-            forLiveLanes([&](int i) { r.v[i] = a.v[i] op b.v[i] ? LaneBools<N>::kSet : 0u; });        \
+            forLiveLanes([&](int i) { r.set(i, a.v[i] op b.v[i]); });                                \
         }                                                                                            \
         return r;                                                                                    \
     }
-    REFRAY_LANES_COMPARE(<)
-    REFRAY_LANES_COMPARE(<=)
-    REFRAY_LANES_COMPARE(>)
-    REFRAY_LANES_COMPARE(>=)
-    REFRAY_LANES_COMPARE(==)
-    REFRAY_LANES_COMPARE(!=)
+    // The predicates are _CMP_LT_OS, _CMP_LE_OS, _CMP_GT_OS, _CMP_GE_OS, _CMP_EQ_OQ, _CMP_NEQ_UQ (GCC's for the
+    // operators) and _MM_CMPINT_LT, LE, NLE, NLT, EQ, NE, as numbers: their macros exist only with AVX.
+    REFRAY_LANES_COMPARE(<, 0x01, 1)
+    REFRAY_LANES_COMPARE(<=, 0x02, 2)
+    REFRAY_LANES_COMPARE(>, 0x0E, 6)
+    REFRAY_LANES_COMPARE(>=, 0x0D, 5)
+    REFRAY_LANES_COMPARE(==, 0x00, 0)
+    REFRAY_LANES_COMPARE(!=, 0x04, 4)
 #undef REFRAY_LANES_COMPARE
 };
 
@@ -269,7 +351,7 @@ template <class S, int N>
     if constexpr (Lanes<S, N>::kVector && sizeof(S) == 4) {
         r.v = detail::selectLanes(m.v, a.v, b.v);
     } else {
-        for (int i = 0; i < N; ++i) r.v[i] = m.v[i] ? a.v[i] : b.v[i];
+        for (int i = 0; i < N; ++i) r.v[i] = m[i] ? a.v[i] : b.v[i];
     }
     return r;
 }
@@ -345,7 +427,7 @@ glm::vec<K, S, Q> lane(const glm::vec<K, Lanes<S, N>, Q>& x, int i) {
 constexpr bool lane(bool m, int) { return m; }
 template <int N>
 constexpr bool lane(const LaneBools<N>& m, int i) {
-    return m.v[i] != 0;
+    return m[i];
 }
 
 // Writes lane i (the whole value for a scalar).
@@ -360,7 +442,7 @@ void setLane(Lanes<S, N>& x, int i, const S& value) {
 }
 template <int N>
 void setLane(LaneBools<N>& m, int i, bool value) {
-    m.v[i] = value ? LaneBools<N>::kSet : 0u;
+    m.set(i, value);
 }
 template <glm::length_t K, class S, int N, glm::qualifier Q>
 void setLane(glm::vec<K, Lanes<S, N>, Q>& x, int i, const glm::vec<K, S, Q>& value) {
@@ -448,9 +530,7 @@ struct ScalarOps<math::Lanes<S, N>> {
             const Ints equal = bits == bits[first];
             uint32_t same = 0;
             if constexpr (sizeof(S) == 4) {
-                math::LaneBools<N> m;
-                m.v = typename math::LaneBools<N>::Storage(equal);
-                same = math::laneBits(m);
+                same = math::detail::vectorLaneBits<N>(equal);
             } else {
                 for (int i = 0; i < N; ++i) same |= equal[i] ? (1u << i) : 0u;
             }
