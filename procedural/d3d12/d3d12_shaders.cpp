@@ -384,10 +384,21 @@ using WideLanes = math::Lanes<float, kWideLanes>;
 void SignedDistanceQueue(uint32_t primitiveType, const Accuracy& accuracy, const math::SphereTraceRay<float>* rays,
                          int count, PrimitiveHit<float>* out) {
     using L = WideLanes;
+    using Tail = WaveLanes<float>;
     [[maybe_unused]] PrecisionScope<L> scope;
+    // The fractal pyramid's Scale^-n, once for the queue rather than at every sample (in the queue's floating-point
+    // mode, as every sample's pow).
+    const auto type = SignedDistancePrimitive(primitiveType);
+    const bool pyramid = type == SignedDistancePrimitive::FractalPyramid;
+    const L wideFactor = pyramid ? math::d3d12::fractalPyramidPrimitiveScaleFactor<L>() : L(0.0f);
+    const Tail tailFactor = pyramid ? math::d3d12::fractalPyramidPrimitiveScaleFactor<Tail>() : Tail(0.0f);
     // Over 16 lanes, and over 8 for the queue's tail.
-    const auto sdf = [primitiveType](const auto& position) {
-        return math::d3d12::GetDistanceFromSignedDistancePrimitive(position, SignedDistancePrimitive(primitiveType));
+    const auto sdf = [type, pyramid, &wideFactor, &tailFactor](const auto& position) {
+        using P = std::remove_cvref_t<decltype(position.x)>;
+        const P* factor = nullptr;
+        if constexpr (std::is_same_v<P, L>) factor = pyramid ? &wideFactor : nullptr;
+        else if constexpr (std::is_same_v<P, Tail>) factor = pyramid ? &tailFactor : nullptr;
+        return math::d3d12::GetDistanceFromSignedDistancePrimitive(position, type, factor);
     };
     std::array<math::SphereTraceResult<float>, kMaxWaveWidth> results;
     math::RaySignedDistancePrimitiveTestQueue<L>(rays, count, sdf, sphereTraceParams(accuracy, 1.0f), results.data());

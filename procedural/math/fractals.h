@@ -652,8 +652,12 @@ inline constexpr int N_FRACTAL_ITERATIONS = 4;
 // h = {sin a, cos a, height}; base half-width a = h.z*h.y/h.x.
 // PORT: the position comes by reference and is copied a component at a time: a vec3 of lanes passed by value was
 // copied with wider loads than the stores that made it (a store-forwarding stall per call).
+// PORT: `scaleFactor`, where the caller has it, is Scale^-iterations (fractalPyramidScaleFactor) computed once for a
+// whole march rather than at every sample: the same bits, since pow depends only on its arguments and the
+// floating-point mode, which a march keeps.
 template <typename T>
-T sdFractalPyramid(const vec3<T>& at, const vec3<T>& h, T Scale = T(2), int iterations = N_FRACTAL_ITERATIONS) {
+T sdFractalPyramid(const vec3<T>& at, const vec3<T>& h, T Scale = T(2), int iterations = N_FRACTAL_ITERATIONS,
+                   const T* scaleFactor = nullptr) {
     vec3<T> position(at.x, at.y, at.z);
     const T a = h.z * h.y / h.x;
     const vec3<T> v1(T(0), h.z, T(0));
@@ -701,7 +705,13 @@ T sdFractalPyramid(const vec3<T>& at, const vec3<T>& h, T Scale = T(2), int iter
         position = Scale * position - v * (Scale - T(1));
     }
     const T distance = sdPyramid(position, h);
-    return distance * hlsl::pow(Scale, static_cast<T>(-n));
+    return distance * (scaleFactor ? *scaleFactor : hlsl::pow(Scale, static_cast<T>(-n)));
+}
+
+// Scale^-n of sdFractalPyramid after its `iterations` iterations (n = iterations, or 0 when there are none).
+template <typename T>
+T fractalPyramidScaleFactor(T Scale = T(2), int iterations = N_FRACTAL_ITERATIONS) {
+    return hlsl::pow(Scale, static_cast<T>(-std::max(iterations, 0)));
 }
 
 // primitiveType values of the D3D12 sample's SignedDistance hit group (i = 3..9).
@@ -715,9 +725,17 @@ enum class SignedDistancePrimitive : std::uint32_t {
     FractalPyramid = 6,
 };
 
-// Local AABB space [-1,1]^3. An unknown type gives 0 (the HLSL default case).
+// The fractal pyramid's Scale^-n (sdFractalPyramid's `scaleFactor`), for a march to compute once.
 template <typename T>
-T GetDistanceFromSignedDistancePrimitive(const vec3<T>& position, SignedDistancePrimitive signedDistancePrimitive) {
+T fractalPyramidPrimitiveScaleFactor() {
+    return fractalPyramidScaleFactor(T(2));
+}
+
+// Local AABB space [-1,1]^3. An unknown type gives 0 (the HLSL default case).
+// PORT: `pyramidScaleFactor`: fractalPyramidPrimitiveScaleFactor's value, where a march computed it once.
+template <typename T>
+T GetDistanceFromSignedDistancePrimitive(const vec3<T>& position, SignedDistancePrimitive signedDistancePrimitive,
+                                         const T* pyramidScaleFactor = nullptr) {
     switch (signedDistancePrimitive) {
         case SignedDistancePrimitive::MiniSpheres: return sdMiniSpheres(position);
         case SignedDistancePrimitive::IntersectedRoundCube: return sdIntersectedRoundCube(position);
@@ -727,7 +745,8 @@ T GetDistanceFromSignedDistancePrimitive(const vec3<T>& position, SignedDistance
         case SignedDistancePrimitive::Cylinder: return sdCylinderColumns(position);
         case SignedDistancePrimitive::FractalPyramid:
             // Base at y == -1 of the AABB; 63.435 degrees at the base, height 2.
-            return sdFractalPyramid(position + vec3<T>(T(0), T(1), T(0)), vec3<T>(T(0.894), T(0.447), T(2.0)), T(2));
+            return sdFractalPyramid(position + vec3<T>(T(0), T(1), T(0)), vec3<T>(T(0.894), T(0.447), T(2.0)), T(2),
+                                    N_FRACTAL_ITERATIONS, pyramidScaleFactor);
     }
     return T(0);
 }
