@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <exception>
 #include <mutex>
@@ -121,6 +122,37 @@ void boundsCallback(const RTCBoundsFunctionArguments* args) {
     enlarge(b);
 }
 
+// refray's own object-space ray (TRV-8) of `gather`'s ray in instance `instanceIndex`: the exact inverse, not
+// Embree's; once per instance met (the instance's primitives share it). Returned in registers on the way to the
+// candidate (a copy read back from the gather was read with wide loads across its narrow stores).
+[[gnu::always_inline]] inline void objectRay(RayGather& gather, uint32_t instanceIndex, vec3& origin, vec3& direction) {
+    if (gather.objectRayInstance != instanceIndex) {
+        const GatherRequest& req = *gather.request;
+        const BuiltInstance& inst = req.tlas->instances()[instanceIndex];
+        origin = inst.worldToObject.transformPoint(req.origin);
+        direction = inst.worldToObject.transformVector(req.direction);
+        gather.objectRayInstance = instanceIndex;
+        gather.objectRayOrigin = origin;
+        gather.objectRayDirection = direction;
+    } else {
+        origin = gather.objectRayOrigin;
+        direction = gather.objectRayDirection;
+    }
+}
+
+// Whether a triangle hit at t lies in the request's [tMin, tMax].
+bool inInterval(const GatherRequest& req, float t) { return t >= req.tMin && t <= req.tMax; }
+
+// `c` filled for a triangle hit `hit` of the ray of `req`, or false when its t lies outside [tMin, tMax].
+[[gnu::always_inline]] inline bool triangleCandidate(const GatherRequest& req, const TriangleIntersection& hit,
+                                                     Candidate& c) {
+    if (!inInterval(req, hit.t)) return false;
+    c.t = c.key = hit.t;
+    c.barycentrics = hit.barycentrics;
+    c.procedural = false;
+    return true;
+}
+
 // refray's exact test of one primitive Embree reports: the candidate, or nothing if the ray misses it. `c` arrives
 // value-initialised (in place in the request's list: a candidate put together on the stack and copied out was read
 // back with wide loads across its narrow stores, a store-forwarding stall per candidate).
@@ -132,20 +164,8 @@ bool exactCandidate(RayGather& gather, uint32_t instanceIndex, void* geometryUse
     const bool triangles = g.type == GeometryType::Triangles;
     if (triangles ? req.skipTriangles : req.skipProcedural) return false;
 
-    // refray's own object-space ray (TRV-8): the exact inverse, not Embree's; once per instance met. Kept in
-    // registers on the way to the candidate (the same stall, on the gather's copy).
     vec3 objectOrigin, objectDirection;
-    if (gather.objectRayInstance != instanceIndex) {
-        const BuiltInstance& inst = req.tlas->instances()[instanceIndex];
-        objectOrigin = inst.worldToObject.transformPoint(req.origin);
-        objectDirection = inst.worldToObject.transformVector(req.direction);
-        gather.objectRayInstance = instanceIndex;
-        gather.objectRayOrigin = objectOrigin;
-        gather.objectRayDirection = objectDirection;
-    } else {
-        objectOrigin = gather.objectRayOrigin;
-        objectDirection = gather.objectRayDirection;
-    }
+    objectRay(gather, instanceIndex, objectOrigin, objectDirection);
     c.instanceIndex = instanceIndex;
     c.geometryIndex = user->geometryIndex;
     c.primitiveIndex = prim;
@@ -155,19 +175,30 @@ bool exactCandidate(RayGather& gather, uint32_t instanceIndex, void* geometryUse
     if (triangles) {
         const vec3* v = &g.triangleVertices[size_t(prim) * 3];
         TriangleIntersection hit;
-        if (!intersectTriangle(objectOrigin, objectDirection, v[0], v[1], v[2], req.alternateEdgeRule, hit) ||
-            !(hit.t >= req.tMin && hit.t <= req.tMax))
-            return false;
-        c.t = c.key = hit.t;
-        c.barycentrics = hit.barycentrics;
-        c.procedural = false;
-    } else {
-        SlabInterval slab;
-        if (!intersectAABB(objectOrigin, objectDirection, g.aabbs[prim], req.tMin, req.tMax, slab)) return false;
-        c.procedural = true;
-        c.key = slab.tEnter;
+        return intersectTriangle(objectOrigin, objectDirection, v[0], v[1], v[2], req.alternateEdgeRule, hit) &&
+               triangleCandidate(req, hit, c);
     }
+    SlabInterval slab;
+    if (!intersectAABB(objectOrigin, objectDirection, g.aabbs[prim], req.tMin, req.tMax, slab)) return false;
+    c.procedural = true;
+    c.key = slab.tEnter;
     return true;
+}
+
+// Closest, for the candidate just added to the ray's list: dropped where it starts beyond the nearest sure commit
+// (the ordered loop would skip it, TRV-2); a triangle sure to commit shrinks Embree's tfar to its t.
+void keepClosest(RayGather& gather, float& tfar) {
+    const GatherRequest& req = *gather.request;
+    std::vector<Candidate>& out = *req.out;
+    const Candidate& c = out.back();
+    if (c.key > gather.nearestCommit) {
+        out.pop_back();
+        return;
+    }
+    if (!c.procedural && req.tMin < c.t && c.t < req.tMax && req.commitsSurely(req.user, c)) {
+        gather.nearestCommit = c.t;
+        tfar = widenedFar(c.t);
+    }
 }
 
 // All and Closest: collect. Closest also shrinks Embree's tfar to the nearest triangle sure to commit.
@@ -179,14 +210,67 @@ void gatherPrimitive(RayGather& gather, uint32_t instanceIndex, void* geometryUs
         out.pop_back();
         return;
     }
-    if (req.mode == GatherMode::Closest) {
-        if (c.key > gather.nearestCommit) {  // the ordered loop would skip it (TRV-2)
-            out.pop_back();
-            return;
+    if (req.mode == GatherMode::Closest) keepClosest(gather, tfar);
+}
+
+// A triangle met by a packet of rays: the exact test of all its rays at once (intersectTriangleLanes; a ray through an
+// edge or vertex of it takes the one-ray test), then each ray's candidate as gatherPrimitive makes it, in the packet's
+// order. Every ray's candidates are those it gets alone.
+void gatherTrianglePacket(GatherContext& ctx, const RTCIntersectFunctionNArguments* args, RTCRayN* ray,
+                          uint32_t instanceIndex, const UserGeometry& user) {
+    const BuiltGeometry& g = *user.geometry;
+    const uint32_t prim = args->primID;
+    const vec3* v = &g.triangleVertices[size_t(prim) * 3];
+    const unsigned N = args->N;
+    RayLanes lanes;
+    std::array<RayGather*, RayLanes::kCount> gathers{};
+    uint32_t active = 0;
+    int first = -1;
+    for (unsigned i = 0; i < N; ++i) {
+        if (!args->valid[i]) continue;
+        RayGather& gather = ctx.rays[RTCRayN_id(ray, N, i)];
+        if (gather.error || gather.request->skipTriangles) continue;  // FLAG-12: no candidate
+        vec3 o, d;
+        objectRay(gather, instanceIndex, o, d);
+        lanes.ox[i] = o.x, lanes.oy[i] = o.y, lanes.oz[i] = o.z;
+        lanes.dx[i] = d.x, lanes.dy[i] = d.y, lanes.dz[i] = d.z;
+        gathers[i] = &gather;
+        active |= 1u << i;
+        if (first < 0) first = int(i);
+    }
+    if (!active) return;
+    for (int i = 0; i < RayLanes::kCount; ++i)  // the lanes without a ray: the first ray's, never read
+        if (!(active >> i & 1u)) {
+            lanes.ox[i] = lanes.ox[first], lanes.oy[i] = lanes.oy[first], lanes.oz[i] = lanes.oz[first];
+            lanes.dx[i] = lanes.dx[first], lanes.dy[i] = lanes.dy[first], lanes.dz[i] = lanes.dz[first];
         }
-        if (!c.procedural && req.tMin < c.t && c.t < req.tMax && req.commitsSurely(req.user, c)) {
-            gather.nearestCommit = c.t;
-            tfar = widenedFar(c.t);
+    intersectTriangleLanes(v[0], v[1], v[2], active, lanes);
+    for (uint32_t rest = lanes.hit | lanes.exact; rest; rest &= rest - 1) {
+        const int i = std::countr_zero(rest);
+        RayGather& gather = *gathers[size_t(i)];
+        const GatherRequest& req = *gather.request;
+        float& tfar = RTCRayN_tfar(ray, N, unsigned(i));
+        try {
+            const vec3 o(lanes.ox[i], lanes.oy[i], lanes.oz[i]), d(lanes.dx[i], lanes.dy[i], lanes.dz[i]);
+            TriangleIntersection hit;
+            if (lanes.exact >> i & 1u) {
+                if (!intersectTriangle(o, d, v[0], v[1], v[2], req.alternateEdgeRule, hit)) continue;
+            } else {
+                hit.t = lanes.t[i];
+                hit.barycentrics = vec2(lanes.b1[i], lanes.b2[i]);
+            }
+            if (!inInterval(req, hit.t)) continue;
+            Candidate& c = req.out->emplace_back();
+            c.instanceIndex = instanceIndex;
+            c.geometryIndex = user.geometryIndex;
+            c.primitiveIndex = prim;
+            c.objectRayOrigin = o;
+            c.objectRayDirection = d;
+            triangleCandidate(req, hit, c);
+            if (req.mode == GatherMode::Closest) keepClosest(gather, tfar);
+        } catch (...) {
+            gather.error = std::current_exception();
+            tfar = -INFINITY;
         }
     }
 }
@@ -197,6 +281,10 @@ void intersectCallback(const RTCIntersectFunctionNArguments* args) {
     auto* ctx = reinterpret_cast<GatherContext*>(args->context);
     RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, args->N);
     const uint32_t instanceIndex = ctx->embree.instID[0];
+    const auto* user = static_cast<const UserGeometry*>(args->geometryUserPtr);
+    if (args->N > 1 && args->N <= unsigned(RayLanes::kCount) && user->geometry->type == GeometryType::Triangles &&
+        user->geometry->active[args->primID])
+        return gatherTrianglePacket(*ctx, args, ray, instanceIndex, *user);
     for (unsigned i = 0; i < args->N; ++i) {
         if (!args->valid[i]) continue;
         RayGather& gather = ctx->rays[RTCRayN_id(ray, args->N, i)];

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -175,6 +176,85 @@ void expectDispatchExactlyOnce(const Mesh& m, const std::vector<RayDesc>& rays, 
             ADD_FAILURE() << "ray " << k << " origin (" << rays[k].Origin.x << "," << rays[k].Origin.y << ","
                           << rays[k].Origin.z << "): " << p[k].anyHits << " any-hit calls";
     EXPECT_EQ(bad, 0u) << "of " << rays.size() << " rays";
+}
+
+// Every ray of `rays` against every triangle of `m`, 16 rays at a time through intersectTriangleLanes (with some lanes
+// left out of each call): each tested lane must be the one-ray test's result bit for bit, a lane in `exact` one the
+// one-ray test must decide (its float edge functions have an exact zero), and an untested lane in neither mask.
+// Returns how many lanes were left to the one-ray test.
+size_t expectLanesMatchOneRay(const Mesh& m, const std::vector<RayDesc>& rays) {
+    size_t bad = 0, exact = 0;
+    for (size_t first = 0; first < rays.size(); first += dxr::RayLanes::kCount) {
+        dxr::RayLanes lanes;
+        uint32_t tested = 0;
+        for (int i = 0; i < dxr::RayLanes::kCount; ++i) {
+            const RayDesc& r = rays[std::min(first + size_t(i), rays.size() - 1)];
+            lanes.ox[i] = r.Origin.x, lanes.oy[i] = r.Origin.y, lanes.oz[i] = r.Origin.z;
+            lanes.dx[i] = r.Direction.x, lanes.dy[i] = r.Direction.y, lanes.dz[i] = r.Direction.z;
+            if (first + size_t(i) < rays.size() && (first / 16 + size_t(i)) % 7 != 3) tested |= 1u << i;
+        }
+        for (size_t t = 0; t < m.count(); ++t) {
+            const vec3 v0 = m.v[3 * t], v1 = m.v[3 * t + 1], v2 = m.v[3 * t + 2];
+            dxr::intersectTriangleLanes(v0, v1, v2, tested, lanes);
+            EXPECT_EQ(lanes.hit & lanes.exact, 0u);
+            EXPECT_EQ((lanes.hit | lanes.exact) & ~tested, 0u);
+            for (int i = 0; i < dxr::RayLanes::kCount; ++i) {
+                if (!(tested >> i & 1u)) continue;
+                const vec3 o(lanes.ox[i], lanes.oy[i], lanes.oz[i]), d(lanes.dx[i], lanes.dy[i], lanes.dz[i]);
+                if (lanes.exact >> i & 1u) {
+                    ++exact;
+                    continue;
+                }
+                const auto one = intersectTriangle(o, d, v0, v1, v2);
+                const bool hit = lanes.hit >> i & 1u;
+                const bool same = hit == one.has_value() &&
+                                  (!hit || (std::bit_cast<uint32_t>(lanes.t[i]) == std::bit_cast<uint32_t>(one->t) &&
+                                            std::bit_cast<uint32_t>(lanes.b1[i]) == std::bit_cast<uint32_t>(one->barycentrics.x) &&
+                                            std::bit_cast<uint32_t>(lanes.b2[i]) == std::bit_cast<uint32_t>(one->barycentrics.y)));
+                if (!same && ++bad <= 5)
+                    ADD_FAILURE() << "ray " << first + size_t(i) << " triangle " << t << ": lanes " << (hit ? "hit" : "miss")
+                                  << (hit ? " t " + std::to_string(lanes.t[i]) : "") << ", one ray "
+                                  << (one ? "hit t " + std::to_string(one->t) : "miss");
+            }
+        }
+    }
+    EXPECT_EQ(bad, 0u) << "of " << rays.size() << " rays";
+    return exact;
+}
+
+// ---------------------------------------------------------------------------------------
+// The broad phase's packet test (intersectTriangleLanes): each lane the one-ray test's result, bit for bit
+
+TEST(Intersection, TRI_1_LanesMatchOneRayOnObliqueRaysThroughJitteredMesh) {
+    expectLanesMatchOneRay(gridMesh(8, 0.3f, 0.08f, 11), obliqueRays(5, 4000));
+}
+
+TEST(Intersection, TRI_2_LanesLeaveRaysThroughEdgesAndVerticesToTheOneRayTest) {
+    // Rays exactly through the grid's vertices and edges: their edge functions have exact zeros.
+    EXPECT_GT(expectLanesMatchOneRay(gridMesh(8, 0.0f, 0.0f, 1), exactFeatureRays(8)), 0u);
+}
+
+TEST(Intersection, TRI_5_LanesMatchOneRayOnParallelZeroNaNAndDegenerateCases) {
+    Mesh m = gridMesh(2, 0.0f, 0.0f, 3);
+    m.add(vec3(0, 0, 0), vec3(1, 1, 0), vec3(2, 2, 0));        // collinear: inactive (DEGEN-7)
+    m.add(vec3(0.5f, 0.5f, 0), vec3(0.5f, 0.5f, 0), vec3(0, 1, 0));  // two equal vertices
+    m.add(vec3(-1, -1, 1), vec3(1, -1, 1), vec3(-1, 1, 1e-30f));     // nearly on edge
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    std::vector<RayDesc> rays = {
+        {vec3(0.1f, 0.2f, -1), 0, vec3(1, 0, 0), 100},        // parallel to the plane
+        {vec3(0.1f, 0.2f, 0), 0, vec3(1, 0.5f, 0), 100},       // in the plane
+        {vec3(0.1f, 0.2f, -1), 0, vec3(0, 0, 0), 100},         // zero direction
+        {vec3(0.1f, 0.2f, -1), 0, vec3(0, 0, nan), 100},       // NaN direction
+        {vec3(nan, 0.2f, -1), 0, vec3(0, 0, 1), 100},          // NaN origin
+        {vec3(0.1f, 0.2f, -1), 0, vec3(0, 0, kInf), 100},      // infinite direction
+        {vec3(0.3f, -0.7f, 1), 0, vec3(0, 0, -1), 100},        // from above
+        {vec3(0.3f, -0.7f, 1), 0, vec3(-0.0f, 0.0f, -1), 100}, // signed zeros
+        {vec3(1e30f, 0, -1), 0, vec3(-1e30f, 0, 1), 100},      // huge values
+        {vec3(0.25f, 0.25f, -1), 0, vec3(1e-30f, 1e-30f, 1), 100},
+    };
+    const std::vector<RayDesc> oblique = obliqueRays(17, 200);
+    rays.insert(rays.end(), oblique.begin(), oblique.end());
+    expectLanesMatchOneRay(m, rays);
 }
 
 // ---------------------------------------------------------------------------------------
