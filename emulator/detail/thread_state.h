@@ -52,28 +52,31 @@ struct NoteTally {
 
 struct WaveLane;
 
+// The fields every TraceRay and invocation touches come first, together, and what only a diagnostic, a note or a
+// profile touches last: a wave keeps 32 of these (1.2 KB each), and a TraceRay of every lane reads its lane's; spread
+// over the state, the hot fields cost a wave's step several more cache lines a lane.
 struct ThreadState {
     DispatchState* dispatch = nullptr;
     WaveLane* lane = nullptr;  // the wave lane this state belongs to (detail/wave.h); null for a probe
-    uvec3 launchIndex{0u};
-    uint64_t linearIndex = 0;
-    DiagnosticLog log;
-    DispatchStats stats;
-    std::vector<Candidate> candidates;
-    uint64_t rayCounter = 0;
-    uint32_t queriesTraced = 0;  // TraceRayInline calls on this launch: numbers RayQuery events
-    std::array<NoteTally, 3> queryNotes;  // ray_query.cpp: Proceed after FALSE, Abort, CommittedRayT with nothing
-    std::vector<Diagnostic> stopErrors;  // OnError::Stop: the errors that ended a launch
-    std::vector<const ShaderExport*> callChain;  // the shaders running on this launch, outermost first
-    GpuVirtualAddress lastTlasAddress = 0;  // one-entry cache of the TLAS lookup
-    const TopLevelAS* lastTlas = nullptr;
-    // Statistics beyond `stats`, in forms cheap to update; folded into `stats` when the dispatch ends.
-    std::vector<ExportCount> exportCounts;  // in first-call order: a handful of exports, searched linearly
-    bool profiling = false;                 // DispatchOptions::profileStages
-    StageClock clock;
     // The worker thread's lookup cache: its wave's, which the wave's lanes share (they run one at a time on that
     // thread, and a cached lookup is a fact of the dispatch, not of a launch); a probe's own.
     LookupCache* lookups = nullptr;
+    bool profiling = false;                 // DispatchOptions::profileStages
+    uint32_t queriesTraced = 0;  // TraceRayInline calls on this launch: numbers RayQuery events
+    uint64_t rayCounter = 0;
+    GpuVirtualAddress lastTlasAddress = 0;  // one-entry cache of the TLAS lookup
+    const TopLevelAS* lastTlas = nullptr;
+    uvec3 launchIndex{0u};
+    uint64_t linearIndex = 0;
+    std::vector<Candidate> candidates;
+    std::vector<const ShaderExport*> callChain;  // the shaders running on this launch, outermost first
+    // Statistics beyond `stats`, in forms cheap to update; folded into `stats` when the dispatch ends.
+    std::vector<ExportCount> exportCounts;  // in first-call order: a handful of exports, searched linearly
+    DispatchStats stats;
+    DiagnosticLog log;
+    std::array<NoteTally, 3> queryNotes;  // ray_query.cpp: Proceed after FALSE, Abort, CommittedRayT with nothing
+    std::vector<Diagnostic> stopErrors;  // OnError::Stop: the errors that ended a launch
+    StageClock clock;
 };
 
 // Charges this thread's time to `stage` while alive, when profiling; otherwise one untaken branch each way.

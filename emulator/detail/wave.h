@@ -27,7 +27,6 @@ struct Wave;
 
 // One lane: the launch it runs, and the TraceRay it waits on.
 struct WaveLane {
-    ThreadState ts;
     Wave* wave = nullptr;
     int index = 0;
     uvec3 launch{0u};  // the launch index the lane runs
@@ -46,6 +45,8 @@ struct WaveLane {
     const WaveFunction* call = nullptr;
     WaveCallKey callKey;
     void* callState = nullptr;
+    // Last: its hot fields (ThreadState's first ones) then follow the lane's own, and its cold ones end the lane.
+    ThreadState ts;
 };
 
 // A worker thread's wave: its lanes and their fibers, kept from wave to wave.
